@@ -1,0 +1,41 @@
+#pragma once
+// File helpers. Every output of every stage is written atomically: into a
+// temporary name in the same directory, then renamed over the final name, so
+// a reader never sees a half-written file or directory.
+
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <string_view>
+
+namespace tega {
+
+std::string read_text_file(const std::filesystem::path& file);  // throws tega::Error
+
+// Calls write(temp_path), then renames temp_path onto `file`. On an exception
+// the temporary is removed and `file` is untouched.
+void write_file_atomic(const std::filesystem::path& file,
+                       const std::function<void(const std::filesystem::path& temp)>& write);
+void write_text_atomic(const std::filesystem::path& file, std::string_view text);
+
+// A directory built under a temporary sibling name and renamed onto its final
+// name by commit(). Uncommitted, it is removed on destruction. An existing
+// final directory is replaced only when `replace_existing`; otherwise the
+// constructor throws tega::Error naming it.
+class StagedDirectory {
+ public:
+  StagedDirectory(std::filesystem::path final_path, bool replace_existing);
+  ~StagedDirectory();
+  StagedDirectory(const StagedDirectory&) = delete;
+  StagedDirectory& operator=(const StagedDirectory&) = delete;
+
+  const std::filesystem::path& path() const { return staging_; }  // write here
+  const std::filesystem::path& final_path() const { return final_; }
+  void commit();
+
+ private:
+  std::filesystem::path final_, staging_;
+  bool replace_existing_, committed_ = false;
+};
+
+}  // namespace tega

@@ -1,0 +1,95 @@
+#pragma once
+// Stage options from YAML. Every stage has a `struct Options` whose fields
+// carry their defaults and document themselves through one visit() method:
+//
+//   struct Options {
+//     int cameras = 13;
+//     template <class V> void visit(V& v) { v("cameras", cameras, "Number of cameras."); }
+//   };
+//
+// A field may itself be a struct with visit() (a nested YAML mapping).
+// Loading is strict: a key that is not a field is an error naming the file,
+// the key and the known keys; so is a value of the wrong type.
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <type_traits>
+#include <variant>
+#include <vector>
+
+#include "tega/core/files.h"
+
+namespace tega {
+
+struct OptionField {
+  using Nested = std::vector<OptionField>;
+  using Target = std::variant<bool*, int*, int64_t*, float*, double*, std::string*, std::vector<int>*,
+                              std::vector<double>*, std::vector<std::string>*, Nested>;
+  std::string key;
+  std::string doc;
+  Target target;
+};
+
+class OptionCollector {
+ public:
+  template <class T>
+  void operator()(const char* key, T& value, const char* doc) {
+    if constexpr (requires { value.visit(*this); }) {
+      OptionCollector nested;
+      value.visit(nested);
+      fields.push_back({key, doc, std::move(nested.fields)});
+    } else {
+      fields.push_back({key, doc, &value});
+    }
+  }
+  std::vector<OptionField> fields;
+};
+
+namespace detail {
+void apply_yaml_text(std::vector<OptionField>& fields, const std::string& yaml, const std::string& section,
+                     const std::string& source);
+std::string fields_to_yaml(const std::vector<OptionField>& fields);
+void set_field(std::vector<OptionField>& fields, const std::string& dotted_key, const std::string& value,
+               const std::string& source);
+}  // namespace detail
+
+// Applies the mapping at `section` (dotted path, "" = whole document) of a YAML
+// file onto `options`; keys it does not set keep their defaults. A missing
+// section leaves everything at its default.
+template <class Options>
+void load_options(Options& options, const std::filesystem::path& file, const std::string& section = "");
+
+// Same, from YAML text; `source` names it in errors.
+template <class Options>
+void load_options_from_string(Options& options, const std::string& yaml, const std::string& section,
+                              const std::string& source) {
+  OptionCollector c;
+  options.visit(c);
+  detail::apply_yaml_text(c.fields, yaml, section, source);
+}
+
+
+template <class Options>
+void load_options(Options& options, const std::filesystem::path& file, const std::string& section) {
+  load_options_from_string(options, read_text_file(file), section, file.string());
+}
+
+// `key=value` override (dotted keys reach nested options); value is YAML.
+template <class Options>
+void set_option(Options& options, const std::string& dotted_key, const std::string& value) {
+  OptionCollector c;
+  options.visit(c);
+  detail::set_field(c.fields, dotted_key, value, "--set " + dotted_key);
+}
+
+// The options as YAML, every field preceded by its documentation as a comment.
+template <class Options>
+std::string options_to_yaml(const Options& options) {
+  Options copy = options;
+  OptionCollector c;
+  copy.visit(c);
+  return detail::fields_to_yaml(c.fields);
+}
+
+}  // namespace tega

@@ -1,0 +1,9 @@
+#pragma once
+// Each subcommand adds itself to the app. A command's callback parses nothing
+// itself beyond CLI11's options and calls the stage library.
+
+#include <CLI/CLI.hpp>
+
+namespace tega::cli {
+void add_synth_command(CLI::App& app);
+}  // namespace tega::cli

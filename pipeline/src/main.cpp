@@ -1,0 +1,38 @@
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <exception>
+#include <iostream>
+
+#include "commands.h"
+#include "tega/core/error.h"
+#include "tega/core/log.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"tega: multi-camera head capture to animatable 3D Gaussian head avatars.\n"
+               "Run `tega <command> --help` for a command's options."};
+  app.set_version_flag("--version", std::string("tega ") + TEGA_VERSION);
+  int verbosity = 1;
+  app.add_flag_function("-v,--verbose", [&](int64_t n) { verbosity = 1 + static_cast<int>(n); },
+                        "More log output (repeat for debug).");
+  app.add_flag_function("-q,--quiet", [&](int64_t) { verbosity = 0; }, "Only warnings and errors.");
+  app.require_subcommand(1);
+  app.parse_complete_callback([&] { tega::init_logging(verbosity); });
+
+#ifdef TEGA_HAVE_SYNTH
+  tega::cli::add_synth_command(app);
+#endif
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const tega::Error& e) {
+    std::cerr << "tega: error: " << e.what() << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "tega: internal error: " << e.what() << "\n";
+    return 2;
+  }
+  return 0;
+}
