@@ -1,0 +1,64 @@
+#pragma once
+// A subject dataset in tega's native layout: what the avatar trainer reads.
+// `tega synth` and `tega ingest multiface` write it; docs/layouts.md#dataset
+// documents it:
+//
+//   DATASET/
+//     dataset.json                 this manifest (frames, split, paths)
+//     rig.json                     the rig (tega rig file, metres)
+//     template.obj                 template topology with UVs, neutral, head space
+//     meshes/<frame>.bin           tracked mesh per frame: float32 V x 3, world space
+//     images/<camera>/<frame>.png  RGBA, 8-bit, alpha = matte, the camera's size
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "tega/core/geometry.h"
+#include "tega/core/mesh.h"
+#include "tega/core/rig.h"
+
+namespace tega {
+
+struct DatasetFrame {
+  std::string id;                // unique; names the mesh and image files
+  std::string sequence;          // expression sequence (take) it was sampled from
+  RigidTransform head_to_world;  // rigid head pose of this frame
+};
+
+struct DatasetSplit {
+  std::vector<std::string> frames;
+  std::vector<std::string> cameras;
+};
+
+struct Dataset {
+  std::filesystem::path root;
+  Rig rig;
+  Mesh template_mesh;                      // neutral, head space, with UVs
+  std::vector<int32_t> eyeball_faces;      // triangles of template_mesh on the eyeballs
+  std::vector<int32_t> landmark_vertices;  // optional (e.g. 68 Multi-PIE landmarks)
+  std::vector<DatasetFrame> frames;
+  DatasetSplit train, test;  // test: held-out frames and held-out cameras
+
+  std::filesystem::path mesh_path(const std::string& frame_id) const;
+  std::filesystem::path image_path(const std::string& camera, const std::string& frame_id) const;
+  const DatasetFrame& frame(const std::string& frame_id) const;  // throws tega::Error
+  Vertices load_mesh(const std::string& frame_id) const;          // checks the vertex count
+};
+
+// Reads dataset.json, the rig and the template. Throws tega::Error naming the
+// file for anything malformed or inconsistent in them.
+Dataset read_dataset(const std::filesystem::path& root);
+
+// Checks everything training relies on before it starts: every split frame
+// and camera exists, every image of a split frame x camera exists with the
+// camera's size and 4 channels, every mesh has the template's vertex count.
+// Throws tega::Error naming the first offending file.
+void validate_dataset(const Dataset& dataset);
+
+// Writes dataset.json, rig.json and template.obj into dataset.root (each
+// atomically). Meshes and images are written by the producer beforehand,
+// at mesh_path() and image_path().
+void write_dataset_manifest(const Dataset& dataset);
+
+}  // namespace tega
