@@ -1,0 +1,16 @@
+#pragma once
+// Size and channel count of a PNG without decoding it: dataset validation
+// checks thousands of images before training starts.
+
+#include <filesystem>
+
+namespace tega {
+
+struct ImageHeader {
+  int width = 0, height = 0, channels = 0, bit_depth = 0;
+};
+
+// Throws tega::Error naming the file when it is missing or not a PNG.
+ImageHeader read_image_header(const std::filesystem::path& png_file);
+
+}  // namespace tega

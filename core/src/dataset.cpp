@@ -1,0 +1,203 @@
+#include "tega/core/dataset.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <set>
+
+#include "tega/core/error.h"
+#include "tega/core/files.h"
+#include "tega/core/image_header.h"
+
+namespace tega {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+constexpr const char* kManifest = "dataset.json";
+constexpr const char* kFormat = "tega-dataset";
+constexpr int kVersion = 1;
+
+json parse_manifest(const fs::path& file) {
+  try {
+    return json::parse(read_text_file(file));
+  } catch (const json::exception& e) {
+    throw Error(file, std::string("is not valid JSON: ") + e.what());
+  }
+}
+
+template <class T>
+T field(const json& object, const char* key, const fs::path& file, const std::string& where) {
+  if (!object.contains(key)) throw Error(file, where + " has no '" + key + "'");
+  try {
+    return object.at(key).get<T>();
+  } catch (const json::exception&) {
+    throw Error(file, where + ": '" + key + "' has the wrong type");
+  }
+}
+
+RigidTransform pose_from_json(const json& rows, const fs::path& file, const std::string& where) {
+  Eigen::Matrix<double, 3, 4> m;
+  try {
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 4; ++c) m(r, c) = rows.at(r).at(c).get<double>();
+  } catch (const json::exception&) {
+    throw Error(file, where + ": head_to_world must be 3 rows of 4 numbers");
+  }
+  const Eigen::Matrix3d R = m.leftCols<3>();
+  if ((R.transpose() * R - Eigen::Matrix3d::Identity()).norm() > 1e-4 || R.determinant() < 0) {
+    throw Error(file, where + ": head_to_world rotation is not a rotation matrix");
+  }
+  return RigidTransform::from_matrix(m);
+}
+
+json pose_to_json(const RigidTransform& pose) {
+  json rows = json::array();
+  const auto m = pose.matrix();
+  for (int r = 0; r < 3; ++r) rows.push_back({m(r, 0), m(r, 1), m(r, 2), m(r, 3)});
+  return rows;
+}
+
+DatasetSplit split_from_json(const json& manifest, const char* name, const fs::path& file) {
+  const auto split = field<json>(manifest, "split", file, "the manifest");
+  const auto part = field<json>(split, name, file, "split");
+  return {field<std::vector<std::string>>(part, "frames", file, std::string("split.") + name),
+          field<std::vector<std::string>>(part, "cameras", file, std::string("split.") + name)};
+}
+
+void check_split_names(const Dataset& d, const DatasetSplit& split, const char* name, const fs::path& file) {
+  std::set<std::string> frames;
+  for (const auto& f : d.frames) frames.insert(f.id);
+  for (const auto& id : split.frames) {
+    if (!frames.count(id)) throw Error(file, std::string("split.") + name + " names unknown frame '" + id + "'");
+  }
+  for (const auto& cam : split.cameras) {
+    if (!d.rig.contains(cam)) {
+      throw Error(file, std::string("split.") + name + " names camera '" + cam + "', which is not in the rig");
+    }
+  }
+}
+
+}  // namespace
+
+fs::path Dataset::mesh_path(const std::string& frame_id) const { return root / "meshes" / (frame_id + ".bin"); }
+
+fs::path Dataset::image_path(const std::string& camera, const std::string& frame_id) const {
+  return root / "images" / camera / (frame_id + ".png");
+}
+
+const DatasetFrame& Dataset::frame(const std::string& frame_id) const {
+  auto it = std::find_if(frames.begin(), frames.end(), [&](const DatasetFrame& f) { return f.id == frame_id; });
+  if (it == frames.end()) throw Error(root / kManifest, "has no frame '" + frame_id + "'");
+  return *it;
+}
+
+Vertices Dataset::load_mesh(const std::string& frame_id) const {
+  return read_vertices_bin(mesh_path(frame_id), template_mesh.num_vertices());
+}
+
+Dataset read_dataset(const fs::path& root) {
+  const fs::path file = root / kManifest;
+  if (!fs::exists(file)) throw Error(root, "is not a tega dataset (no dataset.json)");
+  const json manifest = parse_manifest(file);
+  if (manifest.value("format", "") != kFormat) throw Error(file, "is not a tega dataset manifest (format)");
+  if (manifest.value("version", 0) != kVersion) {
+    throw Error(file, "has dataset version " + std::to_string(manifest.value("version", 0)) +
+                          "; this tega reads version " + std::to_string(kVersion));
+  }
+
+  Dataset d;
+  d.root = root;
+  d.rig = read_rig_json(root / field<std::string>(manifest, "rig", file, "the manifest"));
+  d.template_mesh = read_obj(root / field<std::string>(manifest, "template", file, "the manifest"));
+  if (!d.template_mesh.has_uvs()) throw Error(root / manifest["template"].get<std::string>(), "has no UVs");
+  d.eyeball_faces = manifest.value("eyeball_faces", std::vector<int32_t>{});
+  d.landmark_vertices = manifest.value("landmark_vertices", std::vector<int32_t>{});
+  for (int32_t f : d.eyeball_faces) {
+    if (f < 0 || f >= d.template_mesh.num_faces()) {
+      throw Error(file, "eyeball face " + std::to_string(f) + " is out of range (template has " +
+                            std::to_string(d.template_mesh.num_faces()) + " triangles)");
+    }
+  }
+  for (int32_t v : d.landmark_vertices) {
+    if (v < 0 || v >= d.template_mesh.num_vertices()) {
+      throw Error(file, "landmark vertex " + std::to_string(v) + " is out of range");
+    }
+  }
+
+  std::set<std::string> ids;
+  for (const auto& entry : field<json>(manifest, "frames", file, "the manifest")) {
+    DatasetFrame frame;
+    frame.id = field<std::string>(entry, "id", file, "a frame");
+    const std::string where = "frame '" + frame.id + "'";
+    frame.sequence = entry.value("sequence", "");
+    frame.head_to_world = pose_from_json(field<json>(entry, "head_to_world", file, where), file, where);
+    if (!ids.insert(frame.id).second) throw Error(file, "frame '" + frame.id + "' appears twice");
+    d.frames.push_back(std::move(frame));
+  }
+  d.train = split_from_json(manifest, "train", file);
+  d.test = split_from_json(manifest, "test", file);
+  check_split_names(d, d.train, "train", file);
+  check_split_names(d, d.test, "test", file);
+  return d;
+}
+
+void validate_dataset(const Dataset& d) {
+  const auto check_frame = [&](const std::string& frame_id, const std::vector<std::string>& cameras) {
+    const fs::path mesh = d.mesh_path(frame_id);
+    if (!fs::exists(mesh)) throw Error(mesh, "is missing (tracked mesh of frame '" + frame_id + "')");
+    const auto bytes = fs::file_size(mesh);
+    const auto expected = static_cast<uintmax_t>(d.template_mesh.num_vertices()) * 3 * sizeof(float);
+    if (bytes != expected) {
+      throw Error(mesh, "has " + std::to_string(bytes / 12) + " vertices (" + std::to_string(bytes) +
+                            " bytes); the template has " + std::to_string(d.template_mesh.num_vertices()));
+    }
+    for (const auto& cam : cameras) {
+      const Camera& camera = d.rig.camera(cam);
+      const fs::path image = d.image_path(cam, frame_id);
+      if (!fs::exists(image)) throw Error(image, "is missing (camera '" + cam + "', frame '" + frame_id + "')");
+      const ImageHeader header = read_image_header(image);
+      if (header.width != camera.width || header.height != camera.height) {
+        throw Error(image, "is " + std::to_string(header.width) + "x" + std::to_string(header.height) +
+                               "; the rig says camera '" + cam + "' is " + std::to_string(camera.width) + "x" +
+                               std::to_string(camera.height));
+      }
+      if (header.channels != 4) {
+        throw Error(image, "has " + std::to_string(header.channels) + " channels; dataset images are RGBA");
+      }
+    }
+  };
+  // Evaluation reads train frames from test cameras and test frames from
+  // train cameras, so every frame of either split needs every camera.
+  std::vector<std::string> all_cameras = d.train.cameras;
+  all_cameras.insert(all_cameras.end(), d.test.cameras.begin(), d.test.cameras.end());
+  for (const auto& id : d.train.frames) check_frame(id, all_cameras);
+  for (const auto& id : d.test.frames) check_frame(id, all_cameras);
+}
+
+void write_dataset_manifest(const Dataset& d) {
+  write_rig_json(d.rig, d.root / "rig.json");
+  write_obj(d.template_mesh, d.root / "template.obj");
+  json frames = json::array();
+  for (const auto& f : d.frames) {
+    frames.push_back({{"id", f.id}, {"sequence", f.sequence}, {"head_to_world", pose_to_json(f.head_to_world)}});
+  }
+  const json manifest = {
+      {"format", kFormat},
+      {"version", kVersion},
+      {"rig", "rig.json"},
+      {"template", "template.obj"},
+      {"meshes", "meshes/{frame}.bin"},
+      {"images", "images/{camera}/{frame}.png"},
+      {"eyeball_faces", d.eyeball_faces},
+      {"landmark_vertices", d.landmark_vertices},
+      {"frames", frames},
+      {"split",
+       {{"train", {{"frames", d.train.frames}, {"cameras", d.train.cameras}}},
+        {"test", {{"frames", d.test.frames}, {"cameras", d.test.cameras}}}}},
+  };
+  write_text_atomic(d.root / kManifest, manifest.dump(1));
+}
+
+}  // namespace tega

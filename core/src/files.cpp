@@ -1,0 +1,88 @@
+#include "tega/core/files.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "tega/core/error.h"
+
+namespace tega {
+namespace fs = std::filesystem;
+
+namespace {
+
+// Unique within this process and across processes writing the same directory.
+std::string temporary_suffix() {
+  static std::atomic<uint64_t> counter{0};
+  static const uint64_t salt = std::random_device{}();
+  return ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(salt % 100000) + "-" +
+         std::to_string(counter++);
+}
+
+}  // namespace
+
+std::string read_text_file(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw Error(file, fs::exists(file) ? "cannot be read" : "does not exist");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+void write_file_atomic(const fs::path& file, const std::function<void(const fs::path& temp)>& write) {
+  if (file.has_parent_path()) fs::create_directories(file.parent_path());
+  const fs::path temp = file.string() + temporary_suffix();
+  try {
+    write(temp);
+    fs::rename(temp, file);
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove(temp, ignored);
+    throw;
+  }
+}
+
+void write_text_atomic(const fs::path& file, std::string_view text) {
+  write_file_atomic(file, [&](const fs::path& temp) {
+    std::ofstream out(temp, std::ios::binary);
+    out.write(text.data(), static_cast<std::streamsize>(text.size()));
+    out.close();
+    if (!out) throw Error(file, "could not be written");
+  });
+}
+
+StagedDirectory::StagedDirectory(fs::path final_path, bool replace_existing)
+    : final_(std::move(final_path)), replace_existing_(replace_existing) {
+  if (final_.filename().empty()) final_ = final_.parent_path();  // "out/" -> "out"
+  if (fs::exists(final_) && !replace_existing_) {
+    throw Error(final_, "already exists (pass --force to replace it)");
+  }
+  if (final_.has_parent_path()) fs::create_directories(final_.parent_path());
+  staging_ = final_.string() + temporary_suffix();
+  fs::create_directories(staging_);
+}
+
+StagedDirectory::~StagedDirectory() {
+  if (committed_) return;
+  std::error_code ignored;
+  fs::remove_all(staging_, ignored);
+}
+
+void StagedDirectory::commit() {
+  // rename() cannot replace a non-empty directory, so the old one is moved
+  // aside first and removed only once the new one is in place.
+  fs::path old;
+  if (fs::exists(final_)) {
+    if (!replace_existing_) throw Error(final_, "appeared while it was being written");
+    old = final_.string() + temporary_suffix() + ".old";
+    fs::rename(final_, old);
+  }
+  fs::rename(staging_, final_);
+  committed_ = true;
+  if (!old.empty()) fs::remove_all(old);
+}
+
+}  // namespace tega
