@@ -1,0 +1,127 @@
+#include "tega/core/dataset.h"
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "tega/core/error.h"
+#include "tega/core/files.h"
+#include "tega/core/image.h"
+#include "test_support.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// A two-camera, two-frame dataset on a one-triangle template.
+class DatasetTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    tega::Dataset d;
+    d.root = tmp.path();
+    for (const char* name : {"cam00", "cam01"}) {
+      tega::Camera c;
+      c.name = name;
+      c.width = 8;
+      c.height = 6;
+      c.K << 10, 0, 4, 0, 10, 3, 0, 0, 1;
+      c.world_to_camera.t = {0, 0, 1};
+      d.rig.cameras.push_back(c);
+    }
+    d.template_mesh.positions.resize(3, 3);
+    d.template_mesh.positions << 0, 0, 0, 1, 0, 0, 0, 1, 0;
+    d.template_mesh.faces.resize(1, 3);
+    d.template_mesh.faces << 0, 1, 2;
+    d.template_mesh.uvs.resize(3, 2);
+    d.template_mesh.uvs << 0, 0, 1, 0, 0, 1;
+    d.template_mesh.uv_faces = d.template_mesh.faces;
+    d.template_mesh.triangle_polygon = {0};
+    for (const char* id : {"smile_000000", "blink_000000"}) {
+      tega::DatasetFrame f;
+      f.id = id;
+      f.sequence = std::string(id).substr(0, 5);
+      f.head_to_world.t = {0.01, 0, 0};
+      d.frames.push_back(f);
+      tega::write_vertices_bin(d.template_mesh.positions, d.mesh_path(id));
+      for (const auto& cam : d.rig.cameras) tega::write_image(tega::Image8(8, 6, 4, 128), d.image_path(cam.name, id));
+    }
+    d.train = {{"smile_000000"}, {"cam00"}};
+    d.test = {{"blink_000000"}, {"cam01"}};
+    d.eyeball_faces = {0};
+    tega::write_dataset_manifest(d);
+  }
+
+  std::string validation_error() {
+    try {
+      tega::validate_dataset(tega::read_dataset(tmp.path()));
+    } catch (const tega::Error& e) {
+      return e.what();
+    }
+    return "";
+  }
+
+  void edit_manifest(const std::function<void(nlohmann::json&)>& edit) {
+    auto manifest = nlohmann::json::parse(tega::read_text_file(tmp / "dataset.json"));
+    edit(manifest);
+    tega::write_text_atomic(tmp / "dataset.json", manifest.dump());
+  }
+
+  tega::test::TempDir tmp;
+};
+
+TEST_F(DatasetTest, RoundTripsAndValidates) {
+  const tega::Dataset d = tega::read_dataset(tmp.path());
+  EXPECT_EQ(d.frames.size(), 2u);
+  EXPECT_EQ(d.rig.cameras.size(), 2u);
+  EXPECT_EQ(d.template_mesh.num_vertices(), 3);
+  EXPECT_EQ(d.eyeball_faces, std::vector<int32_t>{0});
+  EXPECT_EQ(d.train.cameras, std::vector<std::string>{"cam00"});
+  EXPECT_EQ(d.test.frames, std::vector<std::string>{"blink_000000"});
+  EXPECT_NEAR(d.frame("smile_000000").head_to_world.t.x(), 0.01, 1e-12);
+  EXPECT_EQ(d.load_mesh("smile_000000").rows(), 3);
+  EXPECT_EQ(validation_error(), "");
+}
+
+TEST_F(DatasetTest, MissingImageIsNamed) {
+  fs::remove(tmp / "images/cam01/smile_000000.png");
+  EXPECT_NE(validation_error().find("images/cam01/smile_000000.png: is missing"), std::string::npos)
+      << validation_error();
+}
+
+TEST_F(DatasetTest, ImageOfTheWrongSizeIsNamed) {
+  tega::write_image(tega::Image8(9, 6, 4), tmp / "images/cam00/blink_000000.png");
+  EXPECT_NE(validation_error().find("cam00/blink_000000.png: is 9x6"), std::string::npos) << validation_error();
+}
+
+TEST_F(DatasetTest, MeshWithTheWrongVertexCountIsNamed) {
+  tega::Vertices four(4, 3);
+  four.setZero();
+  tega::write_vertices_bin(four, tmp / "meshes/blink_000000.bin");
+  EXPECT_NE(validation_error().find("meshes/blink_000000.bin: has 4 vertices"), std::string::npos)
+      << validation_error();
+}
+
+TEST_F(DatasetTest, CameraMissingFromTheRigIsNamed) {
+  edit_manifest([](auto& m) { m["split"]["test"]["cameras"] = {"cam07"}; });
+  const auto message = validation_error();
+  EXPECT_NE(message.find("dataset.json"), std::string::npos) << message;
+  EXPECT_NE(message.find("camera 'cam07', which is not in the rig"), std::string::npos) << message;
+}
+
+TEST_F(DatasetTest, SplitNamingAnUnknownFrameIsNamed) {
+  edit_manifest([](auto& m) { m["split"]["train"]["frames"] = {"smile_000000", "frown_000003"}; });
+  EXPECT_NE(validation_error().find("split.train names unknown frame 'frown_000003'"), std::string::npos)
+      << validation_error();
+}
+
+TEST_F(DatasetTest, NotADatasetIsNamed) {
+  tega::test::TempDir empty;
+  try {
+    tega::read_dataset(empty.path());
+    FAIL();
+  } catch (const tega::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("is not a tega dataset"), std::string::npos);
+  }
+}
+
+}  // namespace

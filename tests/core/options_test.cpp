@@ -1,0 +1,113 @@
+#include "tega/core/options.h"
+
+#include <gtest/gtest.h>
+
+#include "tega/core/error.h"
+#include "test_support.h"
+
+namespace {
+
+struct ScheduleOptions {
+  double start = 1.0;
+  double end = 0.1;
+  template <class V>
+  void visit(V& v) {
+    v("start", start, "Weight at iteration 0.");
+    v("end", end, "Weight at the end.");
+  }
+};
+
+struct ExampleOptions {
+  int cameras = 13;
+  bool antialias = true;
+  std::string name = "studio";
+  std::vector<double> background{0.1, 0.2, 0.3};
+  ScheduleOptions smoothness;
+  template <class V>
+  void visit(V& v) {
+    v("cameras", cameras, "Number of cameras.");
+    v("antialias", antialias, "Supersample edges.");
+    v("name", name, "Name of the take.");
+    v("background", background, "Background colour, linear RGB.");
+    v("smoothness", smoothness, "Smoothness weight schedule.");
+  }
+};
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const tega::Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Options, YamlOverridesOnlyTheKeysItNames) {
+  ExampleOptions o;
+  tega::load_options_from_string(o, "cameras: 6\nsmoothness: {end: 0.5}\n", "", "test.yaml");
+  EXPECT_EQ(o.cameras, 6);
+  EXPECT_DOUBLE_EQ(o.smoothness.end, 0.5);
+  EXPECT_DOUBLE_EQ(o.smoothness.start, 1.0);
+  EXPECT_EQ(o.name, "studio");
+}
+
+TEST(Options, SectionOfALargerDocument) {
+  ExampleOptions o;
+  tega::load_options_from_string(o, "stages:\n  synth:\n    name: demo\n  other: {x: 1}\n", "stages.synth",
+                                 "pipeline.yaml");
+  EXPECT_EQ(o.name, "demo");
+  ExampleOptions untouched;
+  tega::load_options_from_string(untouched, "other: 1\n", "stages.synth", "pipeline.yaml");
+  EXPECT_EQ(untouched.cameras, 13);
+}
+
+TEST(Options, UnknownKeyIsAnErrorNamingFileKeyAndKnownKeys) {
+  ExampleOptions o;
+  const auto message = error_of([&] { tega::load_options_from_string(o, "cameraz: 4\n", "", "studio.yaml"); });
+  EXPECT_NE(message.find("studio.yaml"), std::string::npos) << message;
+  EXPECT_NE(message.find("unknown option 'cameraz'"), std::string::npos) << message;
+  EXPECT_NE(message.find("cameras"), std::string::npos) << message;
+
+  const auto nested =
+      error_of([&] { tega::load_options_from_string(o, "smoothness: {middle: 1}\n", "", "studio.yaml"); });
+  EXPECT_NE(nested.find("'smoothness.middle'"), std::string::npos) << nested;
+}
+
+TEST(Options, WrongTypeIsAnErrorWithLine) {
+  ExampleOptions o;
+  const auto message =
+      error_of([&] { tega::load_options_from_string(o, "name: x\ncameras: many\n", "", "studio.yaml"); });
+  EXPECT_NE(message.find("'cameras' (line 2) must be an integer"), std::string::npos) << message;
+  EXPECT_FALSE(error_of([&] { tega::load_options_from_string(o, "cameras: [1, 2\n", "", "bad.yaml"); }).empty());
+}
+
+TEST(Options, SetOptionReachesNestedFields) {
+  ExampleOptions o;
+  tega::set_option(o, "smoothness.start", "2.5");
+  tega::set_option(o, "background", "[1, 1, 1]");
+  EXPECT_DOUBLE_EQ(o.smoothness.start, 2.5);
+  EXPECT_EQ(o.background, (std::vector<double>{1, 1, 1}));
+  EXPECT_FALSE(error_of([&] { tega::set_option(o, "smoothness.nope", "1"); }).empty());
+}
+
+TEST(Options, PrintedYamlDocumentsEveryFieldAndLoadsBack) {
+  ExampleOptions o;
+  o.cameras = 7;
+  o.smoothness.end = 0.25;
+  const std::string yaml = tega::options_to_yaml(o);
+  EXPECT_NE(yaml.find("# Number of cameras."), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("# Weight at the end."), std::string::npos) << yaml;
+  ExampleOptions back;
+  tega::load_options_from_string(back, yaml, "", "printed");
+  EXPECT_EQ(back.cameras, 7);
+  EXPECT_DOUBLE_EQ(back.smoothness.end, 0.25);
+  EXPECT_EQ(back.background, o.background);
+}
+
+TEST(Options, MissingFileIsNamed) {
+  ExampleOptions o;
+  const auto message = error_of([&] { tega::load_options(o, "/nonexistent/dir/x.yaml"); });
+  EXPECT_NE(message.find("/nonexistent/dir/x.yaml: does not exist"), std::string::npos) << message;
+}
+
+}  // namespace

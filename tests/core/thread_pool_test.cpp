@@ -1,0 +1,50 @@
+#include "tega/core/thread_pool.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <numeric>
+
+#include "tega/core/progress.h"
+
+namespace {
+
+TEST(ThreadPool, ParallelForVisitsEveryIndexOnce) {
+  tega::ThreadPool pool(3);
+  std::vector<std::atomic<int>> visits(1000);
+  pool.parallel_for(0, 1000, [&](int64_t i) { visits[i]++; });
+  for (auto& v : visits) EXPECT_EQ(v.load(), 1);
+}
+
+TEST(ThreadPool, ParallelForRethrowsTheFirstError) {
+  tega::ThreadPool pool(2);
+  EXPECT_THROW(pool.parallel_for(0, 100,
+                                 [](int64_t i) {
+                                   if (i == 37) throw std::runtime_error("bad index");
+                                 }),
+               std::runtime_error);
+  // The pool still works afterwards.
+  std::atomic<int64_t> sum{0};
+  pool.parallel_for(0, 10, [&](int64_t i) { sum += i; });
+  EXPECT_EQ(sum.load(), 45);
+}
+
+TEST(ThreadPool, SubmitReturnsResults) {
+  tega::ThreadPool pool(2);
+  auto a = pool.submit([] { return 6 * 7; });
+  auto b = pool.submit([] { return std::string("ok"); });
+  EXPECT_EQ(a.get(), 42);
+  EXPECT_EQ(b.get(), "ok");
+}
+
+TEST(Progress, CountsFromManyThreadsAndFormatsDurations) {
+  tega::ThreadPool pool(2);
+  tega::Progress progress("test", 500, "items");
+  pool.parallel_for(0, 500, [&](int64_t) { progress.advance(); });
+  EXPECT_EQ(progress.done(), 500);
+  EXPECT_EQ(tega::Progress::format_duration(125), "2:05");
+  EXPECT_EQ(tega::Progress::format_duration(3723), "1:02:03");
+  EXPECT_EQ(tega::Progress::format_duration(-1), "--:--");
+}
+
+}  // namespace
