@@ -6,4 +6,5 @@
 
 namespace tega::cli {
 void add_synth_command(CLI::App& app);
+void add_dataset_command(CLI::App& app);
 }  // namespace tega::cli

@@ -11,6 +11,7 @@
 int main(int argc, char** argv) {
   CLI::App app{"tega: multi-camera head capture to animatable 3D Gaussian head avatars.\n"
                "Run `tega <command> --help` for a command's options."};
+  app.get_formatter()->column_width(44);
   app.set_version_flag("--version", std::string("tega ") + TEGA_VERSION);
   int verbosity = 1;
   app.add_flag_function("-v,--verbose", [&](int64_t n) { verbosity = 1 + static_cast<int>(n); },
@@ -19,6 +20,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.parse_complete_callback([&] { tega::init_logging(verbosity); });
 
+  tega::cli::add_dataset_command(app);
 #ifdef TEGA_HAVE_SYNTH
   tega::cli::add_synth_command(app);
 #endif
