@@ -16,40 +16,7 @@ namespace {
 // A two-camera, two-frame dataset on a one-triangle template.
 class DatasetTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    tega::Dataset d;
-    d.root = tmp.path();
-    for (const char* name : {"cam00", "cam01"}) {
-      tega::Camera c;
-      c.name = name;
-      c.width = 8;
-      c.height = 6;
-      c.K << 10, 0, 4, 0, 10, 3, 0, 0, 1;
-      c.world_to_camera.t = {0, 0, 1};
-      d.rig.cameras.push_back(c);
-    }
-    d.template_mesh.positions.resize(3, 3);
-    d.template_mesh.positions << 0, 0, 0, 1, 0, 0, 0, 1, 0;
-    d.template_mesh.faces.resize(1, 3);
-    d.template_mesh.faces << 0, 1, 2;
-    d.template_mesh.uvs.resize(3, 2);
-    d.template_mesh.uvs << 0, 0, 1, 0, 0, 1;
-    d.template_mesh.uv_faces = d.template_mesh.faces;
-    d.template_mesh.triangle_polygon = {0};
-    for (const char* id : {"smile_000000", "blink_000000"}) {
-      tega::DatasetFrame f;
-      f.id = id;
-      f.sequence = std::string(id).substr(0, 5);
-      f.head_to_world.t = {0.01, 0, 0};
-      d.frames.push_back(f);
-      tega::write_vertices_bin(d.template_mesh.positions, d.mesh_path(id));
-      for (const auto& cam : d.rig.cameras) tega::write_image(tega::Image8(8, 6, 4, 128), d.image_path(cam.name, id));
-    }
-    d.train = {{"smile_000000"}, {"cam00"}};
-    d.test = {{"blink_000000"}, {"cam01"}};
-    d.eyeball_faces = {0};
-    tega::write_dataset_manifest(d);
-  }
+  void SetUp() override { tega::test::write_tiny_dataset(tmp.path()); }
 
   std::string validation_error() {
     try {

@@ -29,6 +29,12 @@ class TempDir {
 
 void write_text(const std::filesystem::path& file, const std::string& text);
 
+// Writes a valid dataset into `root`: a one-triangle template, cameras
+// cam00 (train) and cam01 (test), frames smile_000000 (train) and
+// blink_000000 (test), 8x6 RGBA images whose pixels encode (camera, frame):
+// R = 10 * camera index + frame index.
+void write_tiny_dataset(const std::filesystem::path& root);
+
 }  // namespace tega::test
 
 // Skips the current test, with a message, when ICT-FaceKit is not beside the project.
