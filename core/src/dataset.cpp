@@ -144,6 +144,14 @@ Dataset read_dataset(const fs::path& root) {
 }
 
 void validate_dataset(const Dataset& d) {
+  // The avatar's rasterizer is a pinhole camera: datasets hold undistorted images.
+  for (const auto& camera : d.rig.cameras) {
+    if (camera.has_distortion()) {
+      throw Error(d.root / "rig.json", "camera '" + camera.name +
+                                           "' has lens distortion; dataset images must be undistorted and "
+                                           "their cameras distortion-free");
+    }
+  }
   const auto check_frame = [&](const std::string& frame_id, const std::vector<std::string>& cameras) {
     const fs::path mesh = d.mesh_path(frame_id);
     if (!fs::exists(mesh)) throw Error(mesh, "is missing (tracked mesh of frame '" + frame_id + "')");

@@ -8,7 +8,8 @@
 //     rig.json                     the rig (tega rig file, metres)
 //     template.obj                 template topology with UVs, neutral, head space
 //     meshes/<frame>.bin           tracked mesh per frame: float32 V x 3, world space
-//     images/<camera>/<frame>.png  RGBA, 8-bit, alpha = matte, the camera's size
+//     images/<camera>/<frame>.png  RGBA, 8-bit, alpha = matte, the camera's size,
+//                                  undistorted (the rig's cameras have no distortion)
 
 #include <filesystem>
 #include <string>
@@ -50,7 +51,8 @@ struct Dataset {
 // file for anything malformed or inconsistent in them.
 Dataset read_dataset(const std::filesystem::path& root);
 
-// Checks everything training relies on before it starts: every split frame
+// Checks everything training relies on before it starts: distortion-free
+// cameras (images are undistorted), every split frame
 // and camera exists, every image of a split frame x camera exists with the
 // camera's size and 4 channels, every mesh has the template's vertex count.
 // Throws tega::Error naming the first offending file.
