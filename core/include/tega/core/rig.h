@@ -1,9 +1,10 @@
 #pragma once
-// A calibrated multi-camera rig and its file formats:
-//  - our own JSON rig file (docs/layouts.md#rig-file), in metres;
+// A calibrated multi-camera rig and its file formats (docs/rig-files.md):
+//  - our own JSON rig file, in metres;
 //  - COLMAP text models (cameras.txt + images.txt);
 //  - Multiface "KRT" files (translations in millimetres).
-// Every reader throws tega::Error naming the file and the problem.
+// Every reader throws tega::Error naming the file and the problem; every
+// writer writes atomically and refuses a rig that validate() rejects.
 
 #include <filesystem>
 #include <string>
@@ -21,14 +22,25 @@ struct Rig {
   const Camera& camera(std::string_view name) const;
   bool contains(std::string_view name) const;
   std::vector<std::string> camera_names() const;
+
+  // Throws tega::Error(source, ...) naming the camera and the field when the
+  // rig has no camera or a camera is unusable: an empty name or one with
+  // whitespace or a path separator (names are directory names and tokens of
+  // the text formats), a duplicate name, a non-positive size or focal length,
+  // K not of the form [fx s cx; 0 fy cy; 0 0 1], R not a rotation (to 1e-5),
+  // or a non-finite number.
+  void validate(const std::filesystem::path& source) const;
 };
 
 Rig read_rig_json(const std::filesystem::path& file);
-void write_rig_json(const Rig& rig, const std::filesystem::path& file);  // atomic
+void write_rig_json(const Rig& rig, const std::filesystem::path& file);
 
 // COLMAP text model in `directory` (cameras.txt, images.txt, empty points3D.txt).
-// Camera model OPENCV when k3 == 0, FULL_OPENCV otherwise; PINHOLE for no
-// distortion. `metres_per_unit` converts COLMAP's translations to metres.
+// Camera model PINHOLE for no distortion, OPENCV when k3 == 0, FULL_OPENCV
+// otherwise; the reader also takes SIMPLE_PINHOLE, SIMPLE_RADIAL and RADIAL.
+// An image's NAME is the camera's name. `metres_per_unit` converts COLMAP's
+// translations to metres. The writer creates `directory` and replaces each of
+// the three files atomically.
 Rig read_colmap_text(const std::filesystem::path& directory, double metres_per_unit = 1.0);
 void write_colmap_text(const Rig& rig, const std::filesystem::path& directory,
                        double metres_per_unit = 1.0);
