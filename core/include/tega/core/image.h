@@ -1,8 +1,10 @@
 #pragma once
 // Images: interleaved channels, row-major, top row first.
-// PNG (8/16-bit, grey/RGB/RGBA) is always available (libpng); JPEG, TIFF and
-// EXR need OpenImageIO (built when TEGA_HAVE_OPENIMAGEIO; otherwise those
-// formats throw a tega::Error saying so).
+// Where the build has OpenImageIO (TEGA_HAVE_OPENIMAGEIO) it reads and writes
+// every format (PNG, JPEG, TIFF, EXR, ...). Without it (the GPU machine) PNG
+// (8/16-bit, grey, grey+alpha, RGB, RGBA) goes through libpng and the other
+// formats throw a tega::Error saying so. Colour values are never
+// premultiplied by alpha. See docs/meshes-and-images.md.
 
 #include <cstdint>
 #include <filesystem>
@@ -34,13 +36,20 @@ enum class BitDepth { Auto, U8, U16, F32 };
 
 // Throws tega::Error naming the file when it is missing or not a readable image.
 ImageF read_image(const std::filesystem::path& file);
-Image8 read_image_u8(const std::filesystem::path& file);
-// Atomic (temp file + rename). Values are clamped to [0, 1] for integer formats.
+Image8 read_image_u8(const std::filesystem::path& file);  // 16-bit and float sources are rounded
+// Atomic (temp file + rename). Float values are clamped to [0, 1] and rounded
+// when stored as integers; PNG cannot store F32.
 void write_image(const ImageF& image, const std::filesystem::path& file, BitDepth depth = BitDepth::Auto);
 void write_image(const Image8& image, const std::filesystem::path& file);
 void write_image(const Image16& image, const std::filesystem::path& file);
 
 // Whether this build can read/write the format of `file` (by extension).
 bool image_format_supported(const std::filesystem::path& file);
+
+// The libpng path alone, whatever the build has. It is the only PNG path
+// without OpenImageIO; callable directly so that every build tests it.
+ImageF read_png_with_libpng(const std::filesystem::path& file);
+void write_png_with_libpng(const Image8& image, const std::filesystem::path& file);   // atomic
+void write_png_with_libpng(const Image16& image, const std::filesystem::path& file);  // atomic
 
 }  // namespace tega

@@ -5,10 +5,15 @@
 // the index of the source polygon of every triangle, so part ranges given in
 // polygon indices (e.g. ICT-FaceKit's eyeballs) stay usable.
 //
-// Formats (docs/layouts.md#meshes):
-//  - OBJ (v, vt, f with v/vt or v/vt/vn; normals are ignored)
+// Writers put the triangles of one source polygon back together, so a mesh
+// read and written keeps its polygons and their indices.
+//
+// Formats (docs/meshes-and-images.md):
+//  - OBJ (v, vt, f with v, v/vt, v/vt/vn or v//vn, negative indices too;
+//    normals are ignored)
 //  - PLY, ASCII or binary little-endian, with UVs as the per-face
-//    "texcoord" list property (MeshLab's convention, which keeps seams)
+//    "texcoord" list property (MeshLab's convention, which keeps seams).
+//    Reading rebuilds the UV array in order of first use, without duplicates.
 //  - .bin: raw little-endian float32 vertex positions, V x 3 (Multiface)
 
 #include <Eigen/Core>
@@ -28,23 +33,26 @@ struct Mesh {
   UVs uvs;                               // T x 2 (empty: no UVs); v = 0 at the bottom, as in OBJ
   Triangles uv_faces;                    // F x 3 indices into uvs (empty when uvs is)
   std::vector<int32_t> triangle_polygon; // F entries: source polygon of each triangle
+                                         // (empty: every triangle is its own polygon)
 
   int num_vertices() const { return static_cast<int>(positions.rows()); }
   int num_faces() const { return static_cast<int>(faces.rows()); }
   bool has_uvs() const { return uvs.rows() > 0; }
 
   // Throws tega::Error (naming `source`) on an index out of range or a
-  // face/uv_face count mismatch.
+  // face/uv_face/triangle_polygon count mismatch.
   void validate(const std::filesystem::path& source) const;
   // Area-weighted per-vertex normals (unit length; zero for isolated vertices).
   Vertices vertex_normals() const;
 };
 
+// Readers validate what they read and throw tega::Error naming the file (and,
+// for OBJ, the line) on malformed input.
 Mesh read_obj(const std::filesystem::path& file);
 void write_obj(const Mesh& mesh, const std::filesystem::path& file);  // atomic
 Mesh read_ply(const std::filesystem::path& file);
 void write_ply(const Mesh& mesh, const std::filesystem::path& file);  // binary LE, atomic
-// By extension: .obj or .ply.
+// By extension: .obj or .ply (any other throws tega::Error).
 Mesh read_mesh(const std::filesystem::path& file);
 void write_mesh(const Mesh& mesh, const std::filesystem::path& file);
 

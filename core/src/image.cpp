@@ -1,0 +1,141 @@
+#include "tega/core/image.h"
+
+#include <algorithm>
+#include <cctype>
+#include <string>
+
+#include "image_backends.h"
+#include "tega/core/error.h"
+#include "tega/core/files.h"
+
+namespace tega {
+
+namespace {
+
+namespace fs = std::filesystem;
+using detail::StoredImage;
+
+std::string lowercase_extension(const fs::path& file) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+bool is_png(const fs::path& file) { return lowercase_extension(file) == ".png"; }
+
+#ifndef TEGA_HAVE_OPENIMAGEIO
+[[noreturn]] void throw_needs_oiio(const fs::path& file) {
+  throw Error(file, "this build of tega has no OpenImageIO, so it reads and writes PNG images only");
+}
+#endif
+
+template <typename T>
+void check_buffer(const ImageBuffer<T>& image, const fs::path& file) {
+  const size_t expected = static_cast<size_t>(std::max(image.width, 0)) * std::max(image.height, 0) * image.channels;
+  if (image.width <= 0 || image.height <= 0 || image.channels < 1 || image.channels > 4 ||
+      image.pixels.size() != expected) {
+    throw Error(file, "cannot write a " + std::to_string(image.width) + "x" + std::to_string(image.height) + "x" +
+                          std::to_string(image.channels) + " image holding " + std::to_string(image.pixels.size()) +
+                          " values");
+  }
+}
+
+StoredImage read_stored(const fs::path& file) {
+  if (!fs::exists(file)) throw Error(file, "does not exist");
+#ifdef TEGA_HAVE_OPENIMAGEIO
+  return detail::read_oiio(file);
+#else
+  if (!is_png(file)) throw_needs_oiio(file);
+  return detail::read_png(file);
+#endif
+}
+
+void write_stored(const StoredImage& image, const fs::path& file) {
+  std::visit([&](const auto& buffer) { check_buffer(buffer, file); }, image);
+#ifdef TEGA_HAVE_OPENIMAGEIO
+  write_file_atomic(file, [&](const fs::path& temp) { detail::write_oiio(image, temp, file); });
+#else
+  if (!is_png(file)) throw_needs_oiio(file);
+  write_file_atomic(file, [&](const fs::path& temp) { detail::write_png(image, temp, file); });
+#endif
+}
+
+template <typename T>
+ImageF normalized(const ImageBuffer<T>& image, float max) {
+  ImageF out(image.width, image.height, image.channels);
+  std::transform(image.pixels.begin(), image.pixels.end(), out.pixels.begin(),
+                 [max](T v) { return static_cast<float>(v) / max; });
+  return out;
+}
+
+template <typename T>
+ImageBuffer<T> quantized(const ImageF& image, float max) {
+  ImageBuffer<T> out(image.width, image.height, image.channels);
+  std::transform(image.pixels.begin(), image.pixels.end(), out.pixels.begin(), [max](float v) {
+    const float clamped = v > 0 ? (v < 1 ? v : 1) : 0;  // NaN -> 0
+    return static_cast<T>(clamped * max + 0.5f);
+  });
+  return out;
+}
+
+ImageF to_float(StoredImage&& image) {
+  if (auto* u8 = std::get_if<Image8>(&image)) return normalized(*u8, 255.0f);
+  if (auto* u16 = std::get_if<Image16>(&image)) return normalized(*u16, 65535.0f);
+  return std::move(std::get<ImageF>(image));
+}
+
+}  // namespace
+
+ImageF read_image(const fs::path& file) { return to_float(read_stored(file)); }
+
+Image8 read_image_u8(const fs::path& file) {
+  StoredImage image = read_stored(file);
+  if (auto* u8 = std::get_if<Image8>(&image)) return std::move(*u8);
+  if (auto* u16 = std::get_if<Image16>(&image)) {
+    Image8 out(u16->width, u16->height, u16->channels);
+    std::transform(u16->pixels.begin(), u16->pixels.end(), out.pixels.begin(),
+                   [](uint16_t v) { return static_cast<uint8_t>((uint32_t{v} * 255 + 32767) / 65535); });
+    return out;
+  }
+  return quantized<uint8_t>(std::get<ImageF>(image), 255.0f);
+}
+
+void write_image(const ImageF& image, const fs::path& file, BitDepth depth) {
+  if (depth == BitDepth::Auto) depth = lowercase_extension(file) == ".exr" ? BitDepth::F32 : BitDepth::U8;
+  switch (depth) {
+    case BitDepth::U8: return write_stored(quantized<uint8_t>(image, 255.0f), file);
+    case BitDepth::U16: return write_stored(quantized<uint16_t>(image, 65535.0f), file);
+    case BitDepth::F32:
+    case BitDepth::Auto:
+      if (is_png(file)) throw Error(file, "PNG cannot store float pixels (write 8 or 16 bits)");
+      return write_stored(image, file);
+  }
+}
+
+void write_image(const Image8& image, const fs::path& file) { write_stored(image, file); }
+void write_image(const Image16& image, const fs::path& file) { write_stored(image, file); }
+
+bool image_format_supported(const fs::path& file) {
+#ifdef TEGA_HAVE_OPENIMAGEIO
+  return detail::oiio_can_write(file);
+#else
+  return is_png(file);
+#endif
+}
+
+ImageF read_png_with_libpng(const fs::path& file) {
+  if (!fs::exists(file)) throw Error(file, "does not exist");
+  return to_float(detail::read_png(file));
+}
+
+void write_png_with_libpng(const Image8& image, const fs::path& file) {
+  check_buffer(image, file);
+  write_file_atomic(file, [&](const fs::path& temp) { detail::write_png(image, temp, file); });
+}
+
+void write_png_with_libpng(const Image16& image, const fs::path& file) {
+  check_buffer(image, file);
+  write_file_atomic(file, [&](const fs::path& temp) { detail::write_png(image, temp, file); });
+}
+
+}  // namespace tega

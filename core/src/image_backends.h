@@ -1,0 +1,26 @@
+#pragma once
+// The libraries behind image.h (private to tega_core). Backends read the
+// pixels as the file stores them and write to `target`, a temporary name that
+// image.cpp renames onto `file` (whose name picks the format and appears in
+// errors).
+
+#include <filesystem>
+#include <variant>
+
+#include "tega/core/image.h"
+
+namespace tega::detail {
+
+using StoredImage = std::variant<Image8, Image16, ImageF>;
+
+StoredImage read_png(const std::filesystem::path& file);
+// Image8 or Image16 only.
+void write_png(const StoredImage& image, const std::filesystem::path& target, const std::filesystem::path& file);
+
+#ifdef TEGA_HAVE_OPENIMAGEIO
+StoredImage read_oiio(const std::filesystem::path& file);
+void write_oiio(const StoredImage& image, const std::filesystem::path& target, const std::filesystem::path& file);
+bool oiio_can_write(const std::filesystem::path& file);
+#endif
+
+}  // namespace tega::detail
