@@ -21,8 +21,12 @@ int main(int argc, char** argv) {
   app.parse_complete_callback([&] { tega::init_logging(verbosity); });
 
   tega::cli::add_dataset_command(app);
+  tega::cli::add_rig_command(app);
 #ifdef TEGA_HAVE_SYNTH
   tega::cli::add_synth_command(app);
+#endif
+#ifdef TEGA_HAVE_TRAINER
+  tega::cli::add_train_command(app);
 #endif
 
   try {

@@ -1,0 +1,75 @@
+#pragma once
+// The TeGA avatar: canonical UVD Gaussians, the expression network and the
+// template they live on. pose() turns them into world-space Gaussians for one
+// frame and camera (§3.3-3.5):
+//
+//   xyz = F(uvd) + R_head D(uvd; f_uv)          J = J_F + R_head J_D
+//   Σ_xyz = (J R_q S)(J R_q S)ᵀ                  colour = SH(view) · S(uvd; f_uv^S)
+//
+// D is learned in head space and rotated by the frame's head pose, so that a
+// rigid head motion does not have to be learned by the field. Eyeball
+// Gaussians (by the triangle they map through) are not deformed.
+
+#include <ATen/ATen.h>
+
+#include <Eigen/Core>
+
+#include "tega/core/dataset.h"
+#include "tega/nn/expression_network.h"
+#include "tega/nn/uv_raster.h"
+#include "tega/trainer/gaussians.h"
+#include "tega/trainer/options.h"
+#include "tega/uvd/uvd_map.h"
+
+namespace tega::trainer {
+
+// What one frame contributes, computed once per frame and cached.
+struct FrameInput {
+  uvd::PosedMesh mesh;              // world-space vertices and normals
+  at::Tensor head_rotation;         // [3,3] head -> world
+  at::Tensor displacement_texture;  // [3,T,T] head-space displacement from the template
+};
+
+// Which parts of the model are active at an iteration.
+struct Phase {
+  bool deformation = false;
+  bool shading = false;
+  int sh_degree = 0;
+};
+
+struct PosedGaussians {
+  at::Tensor means;        // [N,3] world
+  at::Tensor covariances;  // [N,6] packed xx, xy, xz, yy, yz, zz
+  at::Tensor colors;       // [N,3] RGB, shading applied
+  at::Tensor opacities;    // [N] in (0,1)
+  at::Tensor world_std_per_scale;  // [N,3] world std per unit of exp(log_scale) (no grad)
+  nn::Latents latents;     // this frame's latents (undefined when the field is off)
+};
+
+class AvatarModel {
+ public:
+  AvatarModel(const Dataset& dataset, const TrainOptions& options, const at::Device& device);
+
+  FrameInput frame_input(const Vertices& world_vertices, const RigidTransform& head_to_world) const;
+  PosedGaussians pose(const FrameInput& frame, const Eigen::Vector3d& camera_centre, const Phase& phase);
+
+  Gaussians gaussians;
+  nn::ExpressionNetwork network{nullptr};
+
+  const uvd::UvTriangleLookup& lookup() const { return lookup_; }
+  double metres_per_uv() const { return metres_per_uv_; }
+  const at::Device& device() const { return device_; }
+
+ private:
+  at::Device device_;
+  uvd::UvTriangleLookup lookup_;
+  nn::UvRasterizer uv_rasterizer_;
+  at::Tensor template_vertices_;  // [V,3] head space
+  at::Tensor eyeball_face_mask_;  // [F] bool
+  double metres_per_uv_ = 1.0;
+};
+
+// sqrt(world area / UV area) of a mesh's triangles: metres per unit of uv.
+double metres_per_uv(const Mesh& mesh);
+
+}  // namespace tega::trainer

@@ -1,0 +1,45 @@
+#pragma once
+// The canonical Gaussians of TeGA (§3.3), living in the template's UVD space:
+// (u, v) on the UV layout, d metres along the interpolated normal. Their
+// shape Σ_uvd = R diag(s)² Rᵀ is in uvd units too, so it follows the mesh
+// through J Σ_uvd Jᵀ.
+
+#include <ATen/ATen.h>
+
+#include <map>
+#include <string>
+
+#include "tega/uvd/uv_lookup.h"
+
+namespace tega::trainer {
+
+struct Gaussians {
+  // Optimised leaves (requires_grad), one row per Gaussian.
+  at::Tensor uvd;            // [N,3]
+  at::Tensor log_scale;      // [N,3] log std along the rotated uvd axes
+  at::Tensor rotation;       // [N,4] quaternion (w, x, y, z), unnormalised
+  at::Tensor sh_dc;          // [N,1,3]
+  at::Tensor sh_rest;        // [N,15,3]
+  at::Tensor opacity_logit;  // [N]
+  // GaussianAvatars-style binding (ablation): the triangle each Gaussian is
+  // bound to, [N] int64; undefined in TeGA's free UVD mode.
+  at::Tensor bound_triangle;
+
+  int64_t size() const { return uvd.size(0); }
+
+  // The parameters by name, as the optimizer and checkpoints see them.
+  static const std::vector<std::string>& parameter_names();
+  at::Tensor& parameter(const std::string& name);
+  std::map<std::string, at::Tensor> tensors() const;  // parameters + bound_triangle if any
+};
+
+// `count` Gaussians spread uniformly over the valid UV area at d = 0, grey,
+// opacity 0.1, isotropic with a world std equal to their mean spacing.
+// `metres_per_uv` converts uv lengths to metres on the template.
+Gaussians initialise_gaussians(const uvd::UvTriangleLookup& lookup, int64_t count, double metres_per_uv,
+                               bool bind_to_triangles, uint64_t seed, const at::TensorOptions& options);
+
+// Rebuilds from checkpoint tensors; throws tega::Error naming what is missing.
+Gaussians gaussians_from_tensors(const std::map<std::string, at::Tensor>& tensors, const at::Device& device);
+
+}  // namespace tega::trainer

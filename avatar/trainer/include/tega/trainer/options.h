@@ -1,0 +1,156 @@
+#pragma once
+// Options of `tega train`. Defaults are the paper's (TeGA §3.6-3.8) and
+// 3D Gaussian Splatting's where the paper follows it. Every schedule is a
+// fraction of `iterations`, so that a short run keeps the paper's shape:
+// at 60K iterations the defaults give a 10K warm-up, densification from 600
+// to 30K every 100 iterations, and an opacity reset every 3K.
+
+#include <string>
+#include <vector>
+
+#include "tega/nn/expression_network.h"
+#include "tega/uvd/uv_lookup.h"
+
+namespace tega::trainer {
+
+struct LearningRates {
+  double position = 5e-5;           // metres; 3DGS's 1.6e-4 x a 0.3 m head
+  double position_final = 5e-7;     // exponential decay to this at the end
+  double sh_dc = 2.5e-3;
+  double sh_rest = 1.25e-4;         // sh_dc / 20, as 3DGS
+  double opacity = 0.05;
+  double scale = 5e-3;              // of log(std)
+  double rotation = 1e-3;
+  double network = 5e-4;            // deformation/shading networks (Yang et al. 2024)
+  double network_final = 5e-6;
+  template <class V>
+  void visit(V& v) {
+    v("position", position, "Step size of Gaussian positions, in metres (u, v are converted through the template's metres per uv unit).");
+    v("position_final", position_final, "Position learning rate at the last iteration (exponential decay).");
+    v("sh_dc", sh_dc, "Learning rate of the degree-0 SH coefficients.");
+    v("sh_rest", sh_rest, "Learning rate of the higher SH coefficients.");
+    v("opacity", opacity, "Learning rate of the opacity logits.");
+    v("scale", scale, "Learning rate of the log standard deviations.");
+    v("rotation", rotation, "Learning rate of the rotation quaternions.");
+    v("network", network, "Learning rate of the U-Net and MLPs.");
+    v("network_final", network_final, "Network learning rate at the last iteration (exponential decay).");
+  }
+};
+
+struct DensifyOptions {
+  bool enabled = true;
+  double start = 0.01;                // fraction of iterations
+  double stop = 0.5;
+  double interval = 100.0 / 60000.0;
+  double opacity_reset_interval = 3000.0 / 60000.0;
+  double gradient_threshold = 2e-4;   // mean |dL/dmean2D| in NDC-like pixel units, as 3DGS
+  double clone_max_std = 3e-3;        // metres: smaller Gaussians are cloned, larger split (3DGS: 1% of extent)
+  double prune_opacity = 0.005;
+  double prune_max_std = 0.03;        // metres: prune larger ones
+  int64_t max_gaussians = 4000000;
+  template <class V>
+  void visit(V& v) {
+    v("enabled", enabled, "Adaptive densification (clone, split, prune, opacity reset). Off = the 'no densify' ablation.");
+    v("start", start, "First densification, as a fraction of iterations.");
+    v("stop", stop, "Last densification, as a fraction of iterations.");
+    v("interval", interval, "Densification period, as a fraction of iterations (at least one iteration).");
+    v("opacity_reset_interval", opacity_reset_interval, "Opacity reset period, as a fraction of iterations.");
+    v("gradient_threshold", gradient_threshold, "Mean screen-space mean-gradient norm above which a Gaussian is densified.");
+    v("clone_max_std", clone_max_std, "Largest world std (metres) of a Gaussian that is cloned rather than split.");
+    v("prune_opacity", prune_opacity, "Gaussians less opaque than this are pruned.");
+    v("prune_max_std", prune_max_std, "Gaussians with a larger world std (metres) are pruned.");
+    v("max_gaussians", max_gaussians, "Upper bound on the number of Gaussians.");
+  }
+};
+
+struct LossOptions {
+  double l1 = 0.8;
+  double dssim = 0.2;
+  std::string vgg_weights;            // safetensors of torchvision's VGG-16 features; "" = no VGG term
+  double vgg_start = 0.5;             // fraction of iterations before which λ_VGG = 0
+  double smoothness_initial = 1.0;
+  double smoothness_final = 0.1;      // reached at half of training
+  int64_t smoothness_samples = 100000;
+  template <class V>
+  void visit(V& v) {
+    v("l1", l1, "Weight of the L1 term.");
+    v("dssim", dssim, "Weight of the D-SSIM term.");
+    v("vgg_weights", vgg_weights, "VGG-16 weight file (safetensors, docs/networks-and-losses.md). Empty: the perceptual term is off (the run log says so).");
+    v("vgg_start", vgg_start, "Fraction of training after which the VGG term starts at 0.01, growing exponentially to 0.1.");
+    v("smoothness_initial", smoothness_initial, "Jacobian smoothness weight at the first iteration.");
+    v("smoothness_final", smoothness_final, "Smoothness weight from mid-training on (exponential decay before).");
+    v("smoothness_samples", smoothness_samples, "Random uvd samples per step for the smoothness term.");
+  }
+};
+
+struct TrainOptions {
+  int64_t iterations = 60000;
+  std::string device = "cpu";
+  int64_t seed = 0;
+  int64_t initial_gaussians = 500000;
+  int sh_degree = 3;
+  double sh_degree_interval = 1000.0 / 60000.0;  // one more SH degree per interval
+  double warmup = 10000.0 / 60000.0;             // canonical warm-up without the field
+  double min_std = 2e-5;                         // metres (0.02 mm)
+  double max_std = 5e-3;                         // metres (5 mm)
+  std::vector<double> background{0.0, 0.0, 0.0};
+  bool deformation_field = true;                 // false: the 'no warp' ablation
+  bool dynamic_shading = true;                   // false: the 'no shading' ablation
+  std::string binding = "uvd";                   // uvd (TeGA) or triangle (GaussianAvatars)
+  bool antialiased = false;
+  int64_t checkpoint_every = 5000;
+  int64_t log_every = 10;
+  int loader_threads = 4;
+  int prefetch = 8;
+  int cpu_threads = 0;                           // 0: all cores
+  bool profile = false;
+  LearningRates learning_rates;
+  DensifyOptions densify;
+  LossOptions loss;
+  nn::NetworkOptions network;
+  uvd::UvLookupOptions uv_lookup;
+
+  template <class V>
+  void visit(V& v) {
+    v("iterations", iterations, "Training iterations (one view each).");
+    v("device", device, "cpu or cuda.");
+    v("seed", seed, "Seed of initialisation, view order and samples; a run is reproducible on the CPU.");
+    v("initial_gaussians", initial_gaussians, "Gaussians sampled uniformly over the UV area at the start.");
+    v("sh_degree", sh_degree, "Highest spherical-harmonics degree (0-3).");
+    v("sh_degree_interval", sh_degree_interval, "Fraction of iterations after which the active SH degree grows by one.");
+    v("warmup", warmup, "Fraction of iterations trained without the deformation field and shading (canonical warm-up).");
+    v("min_std", min_std, "Smallest standard deviation of a Gaussian, metres.");
+    v("max_std", max_std, "Largest standard deviation of a Gaussian, metres.");
+    v("background", background, "Background colour (linear RGB) that images are composited on.");
+    v("deformation_field", deformation_field, "Learn the UVD deformation field. false: the 'no warp' ablation.");
+    v("dynamic_shading", dynamic_shading, "Learn the dynamic shading. false: the 'no shading' ablation (both false: 'no network').");
+    v("binding", binding, "uvd: Gaussians move freely across triangles (TeGA); triangle: each keeps its triangle (GaussianAvatars).");
+    v("antialiased", antialiased, "Mip-Splatting-style antialiased rasterization.");
+    v("checkpoint_every", checkpoint_every, "Iterations between checkpoints (plus one at the end).");
+    v("log_every", log_every, "Iterations between progress lines.");
+    v("loader_threads", loader_threads, "Threads decoding training images ahead of use.");
+    v("prefetch", prefetch, "Training views decoded ahead of use.");
+    v("cpu_threads", cpu_threads, "Threads of libtorch's CPU operations (0: all cores).");
+    v("profile", profile, "Time each part of a step (waits for the device between parts; slower).");
+    v("learning_rates", learning_rates, "Adam learning rates.");
+    v("densify", densify, "Adaptive densification in UVD space.");
+    v("loss", loss, "Loss weights and schedules.");
+    v("network", network, "Deformation and shading networks.");
+    v("uv_lookup", uv_lookup, "uv -> triangle lookup structure.");
+  }
+};
+
+// Iteration at a fraction of training, at least 1 where a period is meant.
+int64_t at_fraction(double fraction, int64_t iterations);
+int64_t period(double fraction, int64_t iterations);
+
+}  // namespace tega::trainer
+
+namespace tega::trainer {
+
+// The paper's Table 1 ablations by name: no-warp, no-shading, no-network,
+// no-densify, ga-binding, mlp-only. Throws tega::Error for another name.
+void apply_ablation(TrainOptions& options, const std::string& ablation);
+const std::vector<std::string>& ablation_names();
+
+}  // namespace tega::trainer

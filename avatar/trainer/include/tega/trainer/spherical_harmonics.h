@@ -1,0 +1,18 @@
+#pragma once
+// View-dependent colour from real spherical harmonics (degree 0-3), in the
+// convention of 3D Gaussian Splatting: rgb = max(Σ_k Y_k(dir) h_k + 0.5, 0).
+// Evaluated with tensor ops (not inside the rasterizer) because TeGA's
+// dynamic shading multiplies this colour per Gaussian before rasterization.
+
+#include <ATen/ATen.h>
+
+namespace tega::trainer {
+
+constexpr int sh_coefficients(int degree) { return (degree + 1) * (degree + 1); }
+
+// sh [N, K, 3] with K >= (degree+1)²; directions [N, 3] (any length, from the
+// camera centre to the Gaussian) -> rgb [N, 3]. Differentiable in sh and
+// directions.
+at::Tensor sh_to_rgb(const at::Tensor& sh, const at::Tensor& directions, int degree);
+
+}  // namespace tega::trainer

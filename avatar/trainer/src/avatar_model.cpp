@@ -1,0 +1,103 @@
+#include "tega/trainer/avatar_model.h"
+
+#include <cmath>
+
+#include "tega/core/error.h"
+#include "tega/trainer/spherical_harmonics.h"
+#include "tega/uvd/covariance.h"
+
+namespace tega::trainer {
+
+double metres_per_uv(const Mesh& mesh) {
+  double world = 0, uv = 0;
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    const Eigen::Vector3f a = mesh.positions.row(mesh.faces(f, 0)), b = mesh.positions.row(mesh.faces(f, 1)),
+                          c = mesh.positions.row(mesh.faces(f, 2));
+    world += 0.5 * (b - a).cross(c - a).norm();
+    const Eigen::Vector2f p = mesh.uvs.row(mesh.uv_faces(f, 0)), q = mesh.uvs.row(mesh.uv_faces(f, 1)),
+                          r = mesh.uvs.row(mesh.uv_faces(f, 2));
+    const Eigen::Vector2f e1 = q - p, e2 = r - p;
+    uv += 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
+  }
+  if (uv <= 0) throw Error("the template's UV layout has no area");
+  return std::sqrt(world / uv);
+}
+
+namespace {
+
+at::Tensor to_tensor(const Vertices& v, const at::Device& device) {
+  return at::from_blob(const_cast<float*>(v.data()), {v.rows(), 3}, at::kFloat).to(device, /*non_blocking=*/false,
+                                                                                    /*copy=*/true);
+}
+
+at::Tensor to_tensor(const Eigen::Matrix3d& m, const at::Device& device) {
+  const Eigen::Matrix<float, 3, 3, Eigen::RowMajor> f = m.cast<float>();
+  return at::from_blob(const_cast<float*>(f.data()), {3, 3}, at::kFloat).to(device, false, true);
+}
+
+}  // namespace
+
+AvatarModel::AvatarModel(const Dataset& dataset, const TrainOptions& options, const at::Device& device)
+    : device_(device),
+      lookup_(uvd::UvTriangleLookup(dataset.template_mesh, options.uv_lookup).to(device)),
+      uv_rasterizer_(nn::UvRasterizer(dataset.template_mesh, options.network.texture_size).to(device)),
+      template_vertices_(to_tensor(dataset.template_mesh.positions, device)),
+      metres_per_uv_(trainer::metres_per_uv(dataset.template_mesh)) {
+  eyeball_face_mask_ = at::zeros({dataset.template_mesh.num_faces()}, at::TensorOptions(at::kBool));
+  for (int32_t f : dataset.eyeball_faces) eyeball_face_mask_[f] = true;
+  eyeball_face_mask_ = eyeball_face_mask_.to(device);
+  network = nn::ExpressionNetwork(options.network);
+  network->to(device);
+}
+
+FrameInput AvatarModel::frame_input(const Vertices& world_vertices, const RigidTransform& head_to_world) const {
+  at::NoGradGuard no_grad;
+  FrameInput frame;
+  const at::Tensor world = to_tensor(world_vertices, device_);
+  frame.mesh = uvd::pose(lookup_, world);
+  frame.head_rotation = to_tensor(head_to_world.R, device_);
+  const at::Tensor translation =
+      at::tensor({head_to_world.t.x(), head_to_world.t.y(), head_to_world.t.z()}, at::kFloat).to(device_);
+  // Row vectors: R^T (x - t) is (x - t) R.
+  const at::Tensor head_space = (world - translation).matmul(frame.head_rotation);
+  frame.displacement_texture = uv_rasterizer_.rasterize(head_space - template_vertices_);
+  return frame;
+}
+
+PosedGaussians AvatarModel::pose(const FrameInput& frame, const Eigen::Vector3d& camera_centre, const Phase& phase) {
+  PosedGaussians out;
+  const Gaussians& g = gaussians;
+  const uvd::UvdMapping mapping = uvd::uvd_to_world(g.uvd, frame.mesh, lookup_, g.bound_triangle);
+  at::Tensor means = mapping.xyz;
+  at::Tensor jacobian = mapping.jacobian;
+
+  at::Tensor shading;
+  if (phase.deformation || phase.shading) {
+    out.latents = network->encode(frame.displacement_texture);
+    if (phase.deformation) {
+      const nn::FieldWithJacobian field = network->deform(g.uvd, out.latents, /*with_jacobian=*/true);
+      const at::Tensor movable = eyeball_face_mask_.index_select(0, mapping.triangle).logical_not().to(means.dtype());
+      // Head space -> world: Δ_world = R Δ, J_world = R J (row vectors: Δ Rᵀ).
+      means = means + field.value.matmul(frame.head_rotation.t()) * movable.unsqueeze(1);
+      jacobian = jacobian + frame.head_rotation.matmul(field.jacobian) * movable.view({-1, 1, 1});
+    }
+    if (phase.shading) shading = network->shade(g.uvd, out.latents);
+  }
+
+  const at::Tensor rotation = uvd::rotation_from_quaternion(g.rotation);
+  const at::Tensor jacobian_rotation = jacobian.bmm(rotation);  // [N,3,3]
+  const at::Tensor shape = jacobian_rotation * g.log_scale.exp().unsqueeze(1);  // columns scaled by std
+  out.covariances = uvd::pack_symmetric(shape.bmm(shape.transpose(1, 2)));
+  out.world_std_per_scale = jacobian_rotation.detach().norm(2, 1);
+  out.means = means;
+
+  const at::Tensor centre = at::tensor({camera_centre.x(), camera_centre.y(), camera_centre.z()},
+                                       means.options().requires_grad(false));
+  at::Tensor colors = sh_to_rgb(at::cat({g.sh_dc, g.sh_rest}, 1), means - centre, phase.sh_degree);
+  if (shading.defined()) colors = colors * shading.unsqueeze(1);
+  out.colors = colors;
+  out.opacities = at::sigmoid(g.opacity_logit);
+  return out;
+}
+
+}  // namespace tega::trainer

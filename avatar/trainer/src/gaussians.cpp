@@ -1,0 +1,69 @@
+#include "tega/trainer/gaussians.h"
+
+#include <cmath>
+
+#include "tega/core/error.h"
+
+namespace tega::trainer {
+
+const std::vector<std::string>& Gaussians::parameter_names() {
+  static const std::vector<std::string> names{"uvd", "log_scale", "rotation", "sh_dc", "sh_rest", "opacity_logit"};
+  return names;
+}
+
+at::Tensor& Gaussians::parameter(const std::string& name) {
+  if (name == "uvd") return uvd;
+  if (name == "log_scale") return log_scale;
+  if (name == "rotation") return rotation;
+  if (name == "sh_dc") return sh_dc;
+  if (name == "sh_rest") return sh_rest;
+  if (name == "opacity_logit") return opacity_logit;
+  throw Error("no Gaussian parameter '" + name + "'");
+}
+
+std::map<std::string, at::Tensor> Gaussians::tensors() const {
+  std::map<std::string, at::Tensor> t{{"gaussians.uvd", uvd},
+                                      {"gaussians.log_scale", log_scale},
+                                      {"gaussians.rotation", rotation},
+                                      {"gaussians.sh_dc", sh_dc},
+                                      {"gaussians.sh_rest", sh_rest},
+                                      {"gaussians.opacity_logit", opacity_logit}};
+  if (bound_triangle.defined()) t["gaussians.bound_triangle"] = bound_triangle;
+  return t;
+}
+
+Gaussians initialise_gaussians(const uvd::UvTriangleLookup& lookup, int64_t count, double metres_per_uv,
+                               bool bind_to_triangles, uint64_t seed, const at::TensorOptions& options) {
+  at::NoGradGuard no_grad;
+  Gaussians g;
+  const at::Tensor uv = lookup.sample_uniform(count, seed).to(options);
+  g.uvd = at::cat({uv, at::zeros({count, 1}, options)}, 1);
+  // Mean spacing of `count` points over the valid UV area.
+  const double uv_area = lookup.uv_area().sum().item<double>();
+  const double spacing_uv = std::sqrt(uv_area / static_cast<double>(count));
+  const double spacing_m = spacing_uv * metres_per_uv;
+  g.log_scale = at::tensor({std::log(spacing_uv), std::log(spacing_uv), std::log(spacing_m)}, options)
+                    .repeat({count, 1});
+  g.rotation = at::zeros({count, 4}, options);
+  g.rotation.select(1, 0).fill_(1.0);
+  g.sh_dc = at::zeros({count, 1, 3}, options);  // colour 0.5
+  g.sh_rest = at::zeros({count, 15, 3}, options);
+  g.opacity_logit = at::full({count}, std::log(0.1 / 0.9), options);
+  if (bind_to_triangles) g.bound_triangle = lookup.lookup(uv).triangle;
+  for (const auto& name : Gaussians::parameter_names()) g.parameter(name).requires_grad_(true);
+  return g;
+}
+
+Gaussians gaussians_from_tensors(const std::map<std::string, at::Tensor>& tensors, const at::Device& device) {
+  Gaussians g;
+  for (const auto& name : Gaussians::parameter_names()) {
+    auto it = tensors.find("gaussians." + name);
+    if (it == tensors.end()) throw Error("checkpoint has no tensor 'gaussians." + name + "'");
+    g.parameter(name) = it->second.to(device).detach().requires_grad_(true);
+  }
+  auto bound = tensors.find("gaussians.bound_triangle");
+  if (bound != tensors.end()) g.bound_triangle = bound->second.to(device);
+  return g;
+}
+
+}  // namespace tega::trainer

@@ -1,0 +1,402 @@
+#include "tega/trainer/trainer.h"
+
+#include <ATen/ATen.h>
+#include <ATen/CPUGeneratorImpl.h>
+#include <ATen/Parallel.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+
+#include "tega/core/error.h"
+#include "tega/core/files.h"
+#include "tega/core/options.h"
+#include "tega/core/progress.h"
+#include "tega/nn/losses.h"
+#include "tega/nn/module_io.h"
+#include "tega/nn/vgg_loss.h"
+#include "tega/splat/rasterize.h"
+#include "tega/trainer/avatar_model.h"
+#include "tega/trainer/checkpoint.h"
+#include "tega/trainer/densifier.h"
+#include "tega/trainer/render.h"
+#include "tega/trainer/schedules.h"
+#include "tega/trainer/step_profiler.h"
+#include "tega/trainer/view_loader.h"
+
+namespace tega::trainer {
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kCheckpoint = "checkpoint.safetensors";
+constexpr const char* kOptions = "options.yaml";
+constexpr const char* kMetrics = "metrics.csv";
+
+struct MetricRow {
+  int64_t iteration;
+  double loss, psnr;
+  int64_t gaussians;
+  double seconds;
+};
+
+std::vector<View> views_of(const Dataset& d, const std::vector<std::string>& frames,
+                           const std::vector<std::string>& cameras) {
+  std::vector<View> views;
+  for (const auto& cam : cameras) {
+    const auto names = d.rig.camera_names();
+    const int c = static_cast<int>(std::find(names.begin(), names.end(), cam) - names.begin());
+    for (const auto& id : frames) {
+      const int f = static_cast<int>(
+          std::find_if(d.frames.begin(), d.frames.end(), [&](const DatasetFrame& x) { return x.id == id; }) -
+          d.frames.begin());
+      views.push_back({c, f});
+    }
+  }
+  return views;
+}
+
+void write_metrics(const fs::path& file, const std::vector<MetricRow>& rows) {
+  std::ostringstream out;
+  out << "iteration,loss,psnr,gaussians,seconds\n";
+  for (const auto& r : rows) out << r.iteration << ',' << r.loss << ',' << r.psnr << ',' << r.gaussians << ',' << r.seconds << '\n';
+  write_text_atomic(file, out.str());
+}
+
+std::vector<MetricRow> read_metrics(const fs::path& file, int64_t up_to_iteration) {
+  std::vector<MetricRow> rows;
+  std::ifstream in(file);
+  std::string line;
+  std::getline(in, line);  // header
+  while (std::getline(in, line)) {
+    MetricRow r{};
+    char comma;
+    std::istringstream fields(line);
+    fields >> r.iteration >> comma >> r.loss >> comma >> r.psnr >> comma >> r.gaussians >> comma >> r.seconds;
+    if (fields && r.iteration <= up_to_iteration) rows.push_back(r);
+  }
+  return rows;
+}
+
+double exponential(double from, double to, double t) { return from * std::pow(to / from, std::clamp(t, 0.0, 1.0)); }
+
+// One training run: the model, its optimizer and everything a checkpoint holds.
+class Run {
+ public:
+  Run(const fs::path& dataset_dir, const fs::path& run_dir, const TrainOptions& options, bool resume)
+      : options_(options),
+        run_dir_(run_dir),
+        device_(options.device),
+        dataset_(read_dataset(dataset_dir)),
+        model_((validate_dataset(dataset_), dataset_), options, device_),
+        generator_(at::make_generator<at::CPUGeneratorImpl>(static_cast<uint64_t>(options.seed))),
+        profiler_(options.profile, device_) {
+    if (options_.binding != "uvd" && options_.binding != "triangle") {
+      throw Error("binding must be 'uvd' or 'triangle', not '" + options_.binding + "'");
+    }
+    train_views_ = views_of(dataset_, dataset_.train.frames, dataset_.train.cameras);
+    heldout_views_ = views_of(dataset_, dataset_.train.frames, dataset_.test.cameras);
+    if (!options_.loss.vgg_weights.empty()) {
+      vgg_.emplace(nn::VggPerceptualLoss::load(options_.loss.vgg_weights));
+      vgg_->to(device_);
+    } else {
+      spdlog::info("perceptual (VGG) loss: off (no loss.vgg_weights configured)");
+    }
+    background_ = at::tensor(options_.background, at::kFloat).to(device_);
+
+    if (resume) {
+      restore(read_checkpoint(run_dir_ / kCheckpoint));
+    } else {
+      model_.gaussians = initialise_gaussians(model_.lookup(), options_.initial_gaussians, model_.metres_per_uv(),
+                                              options_.binding == "triangle", static_cast<uint64_t>(options_.seed),
+                                              at::TensorOptions(at::kFloat).device(device_));
+      register_parameters();
+      stats_ = splat::MeanGradientStats::zeros(model_.gaussians.uvd);
+      max_world_std_ = at::zeros({model_.gaussians.size()}, background_.options());
+    }
+    spdlog::info("dataset {}: {} frames, {} cameras; {} training views, template {} vertices; {} Gaussians",
+                 dataset_dir.string(), dataset_.frames.size(), dataset_.rig.cameras.size(), train_views_.size(),
+                 dataset_.template_mesh.num_vertices(), model_.gaussians.size());
+  }
+
+  TrainSummary train() {
+    ViewLoader loader(dataset_, train_views_, static_cast<uint64_t>(options_.seed), options_.loader_threads,
+                      options_.prefetch);
+    loader.seek(iteration_);
+    const auto start = std::chrono::steady_clock::now();
+    const int64_t first = iteration_;
+    double window_loss = 0, window_psnr = 0;
+    int window = 0;
+    TrainSummary summary;
+    while (iteration_ < options_.iterations) {
+      profiler_.section("data");
+      const LoadedView view = loader.next();
+      const auto [loss, mse] = step(view);
+      ++iteration_;
+      window_loss += loss;
+      window_psnr += -10.0 * std::log10(std::max(mse, 1e-12));
+      ++window;
+      if (iteration_ % options_.log_every == 0 || iteration_ == options_.iterations) {
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        const double rate = static_cast<double>(iteration_ - first) / std::max(seconds, 1e-9);
+        summary.final_loss = window_loss / window;
+        summary.train_psnr = window_psnr / window;
+        metrics_.push_back({iteration_, summary.final_loss, summary.train_psnr, model_.gaussians.size(), seconds});
+        spdlog::info("it {}/{}  loss {:.5f}  psnr {:.2f}  gaussians {}  {:.2f} it/s  ETA {}", iteration_,
+                     options_.iterations, summary.final_loss, summary.train_psnr, model_.gaussians.size(), rate,
+                     Progress::format_duration(static_cast<double>(options_.iterations - iteration_) / rate));
+        window_loss = window_psnr = 0;
+        window = 0;
+      }
+      if (iteration_ % options_.checkpoint_every == 0 && iteration_ < options_.iterations) save();
+    }
+    profiler_.stop();
+    save();
+    summary.iterations = iteration_;
+    summary.gaussians = model_.gaussians.size();
+    summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    summary.heldout_psnr = heldout_psnr();
+    summary.checkpoint = run_dir_ / kCheckpoint;
+    if (profiler_.enabled()) {
+      for (const auto& [name, ms] : profiler_.mean_milliseconds(iteration_ - first)) {
+        spdlog::info("profile: {:>14} {:8.2f} ms/it", name, ms);
+      }
+    }
+    return summary;
+  }
+
+ private:
+  Phase phase() const {
+    Phase p;
+    const bool warm = iteration_ >= at_fraction(options_.warmup, options_.iterations);
+    p.deformation = warm && options_.deformation_field;
+    p.shading = warm && options_.dynamic_shading;
+    p.sh_degree = static_cast<int>(std::min<int64_t>(
+        options_.sh_degree, iteration_ / period(options_.sh_degree_interval, options_.iterations)));
+    return p;
+  }
+
+  const FrameInput& frame_input(int frame) {
+    auto it = frames_.find(frame);
+    if (it == frames_.end()) {
+      const auto& f = dataset_.frames[frame];
+      it = frames_.emplace(frame, model_.frame_input(dataset_.load_mesh(f.id), f.head_to_world)).first;
+    }
+    return it->second;
+  }
+
+  // Forward, backward and update on one view. Returns (loss, mse).
+  std::pair<double, double> step(const LoadedView& loaded) {
+    const Camera& camera = dataset_.rig.cameras[loaded.view.camera];
+    const Phase p = phase();
+    update_learning_rates();
+
+    profiler_.section("networks+jacobians");
+    const FrameInput& frame = frame_input(loaded.view.frame);
+    PosedGaussians posed = model_.pose(frame, camera.center(), p);
+
+    profiler_.section("rasterization");
+    const splat::RasterOutput raster =
+        splat::rasterize(posed.means, posed.covariances, posed.colors, posed.opacities, background_,
+                         {raster_camera(camera)}, raster_settings(camera, options_.antialiased), &stats_);
+
+    profiler_.section("losses");
+    const at::Tensor rendered = raster.rgb[0].permute({2, 0, 1});
+    const at::Tensor target = composite_target(loaded.rgba.to(device_), background_);
+    at::Tensor loss = options_.loss.l1 * nn::l1_loss(rendered, target) +
+                      options_.loss.dssim * nn::dssim_loss(rendered, target);
+    const double vgg_weight = schedules::vgg_weight(options_.loss, iteration_, options_.iterations);
+    if (vgg_ && vgg_weight > 0) loss = loss + vgg_weight * (*vgg_)(rendered.unsqueeze(0), target.unsqueeze(0));
+    if (p.deformation && options_.loss.smoothness_samples > 0) {
+      const at::Tensor samples =
+          nn::sample_smoothness_uvd(options_.loss.smoothness_samples, at::TensorOptions(at::kFloat), generator_)
+              .to(device_);
+      const at::Tensor jacobians = model_.network->deform(samples, posed.latents, true).jacobian;
+      loss = loss + schedules::smoothness_weight(options_.loss, iteration_, options_.iterations) *
+                        nn::jacobian_smoothness_loss(jacobians, nn::Reduction::mean);
+    }
+    const at::Tensor mse = (rendered.detach() - target).pow(2).mean();
+
+    profiler_.section("backward");
+    adam_.zero_grad();
+    loss.backward();
+    check_finite(loss, loaded);
+
+    profiler_.section("optimizer");
+    adam_.step();
+    clamp_world_size(model_.gaussians, posed.world_std_per_scale, options_.min_std, options_.max_std);
+    {
+      at::NoGradGuard no_grad;
+      const at::Tensor world_std = (model_.gaussians.log_scale.exp() * posed.world_std_per_scale).amax(1);
+      max_world_std_ = at::max(max_world_std_, world_std);
+    }
+
+    profiler_.section("densification");
+    densify_if_due(camera);
+    return {loss.item<double>(), mse.item<double>()};
+  }
+
+  void check_finite(const at::Tensor& loss, const LoadedView& loaded) {
+    std::vector<at::Tensor> finite{at::isfinite(loss).all()};
+    for (const auto& g : adam_.groups()) {
+      if (g.parameter.grad().defined()) finite.push_back(at::isfinite(g.parameter.grad()).all());
+    }
+    if (at::stack(finite).all().item<bool>()) return;
+    throw Error("iteration " + std::to_string(iteration_ + 1) + ": the loss or a gradient is NaN/Inf (camera " +
+                dataset_.rig.cameras[loaded.view.camera].name + ", frame " + dataset_.frames[loaded.view.frame].id +
+                "); training stopped, the last checkpoint (iteration " + std::to_string(saved_iteration_) +
+                ") is intact");
+  }
+
+  void update_learning_rates() {
+    const double t = static_cast<double>(iteration_) / static_cast<double>(std::max<int64_t>(1, options_.iterations - 1));
+    const auto& lr = options_.learning_rates;
+    adam_.group("uvd").learning_rate = exponential(lr.position, lr.position_final, t);
+    const double network_lr = exponential(lr.network, lr.network_final, t);
+    for (auto& name : network_groups_) adam_.group(name).learning_rate = network_lr;
+  }
+
+  void densify_if_due(const Camera& camera) {
+    const auto& d = options_.densify;
+    const int64_t it = iteration_ + 1;  // this step's number, 1-based
+    if (!d.enabled || it < at_fraction(d.start, options_.iterations) || it > at_fraction(d.stop, options_.iterations)) {
+      return;
+    }
+    if (it % period(d.interval, options_.iterations) == 0) {
+      // 3DGS's threshold is on gradients w.r.t. normalised device coordinates;
+      // the rasterizer reports them per pixel.
+      const double pixels_per_ndc = 0.5 * std::max(camera.width, camera.height);
+      DensifyStats stats{stats_.grad_norm_sum * pixels_per_ndc, stats_.visible_count, max_world_std_};
+      const DensifyResult r = densify(model_.gaussians, adam_, stats, d, model_.lookup(), generator_);
+      spdlog::debug("densify at {}: cloned {}, split {}, pruned {} -> {} Gaussians", it, r.cloned, r.split, r.pruned,
+                    model_.gaussians.size());
+      stats_ = splat::MeanGradientStats::zeros(model_.gaussians.uvd);
+      max_world_std_ = at::zeros({model_.gaussians.size()}, background_.options());
+    }
+    if (it % period(d.opacity_reset_interval, options_.iterations) == 0) reset_opacity(model_.gaussians, adam_);
+  }
+
+  void register_parameters() {
+    adam_ = Adam();
+    const auto& lr = options_.learning_rates;
+    auto& g = model_.gaussians;
+    const double uv = 1.0 / model_.metres_per_uv();
+    adam_.add("uvd", g.uvd, lr.position, at::tensor({uv, uv, 1.0}, g.uvd.options().requires_grad(false)).view({1, 3}));
+    adam_.add("log_scale", g.log_scale, lr.scale);
+    adam_.add("rotation", g.rotation, lr.rotation);
+    adam_.add("sh_dc", g.sh_dc, lr.sh_dc);
+    adam_.add("sh_rest", g.sh_rest, lr.sh_rest);
+    adam_.add("opacity_logit", g.opacity_logit, lr.opacity);
+    network_groups_.clear();
+    for (const auto& item : model_.network->named_parameters(true)) {
+      network_groups_.push_back("network." + item.key());
+      adam_.add(network_groups_.back(), item.value(), lr.network);
+    }
+  }
+
+  void save() {
+    Checkpoint c;
+    for (const auto& [name, tensor] : model_.gaussians.tensors()) c.tensors[name] = tensor.detach();
+    for (const auto& [name, tensor] : nn::module_tensors(*model_.network, "network.")) c.tensors[name] = tensor.detach();
+    for (const auto& [name, tensor] : adam_.state()) c.tensors[name] = tensor;
+    c.tensors["densify.gradient_norm_sum"] = stats_.grad_norm_sum;
+    c.tensors["densify.visible_count"] = stats_.visible_count;
+    c.tensors["densify.max_world_std"] = max_world_std_;
+    c.tensors["trainer.iteration"] = at::tensor({iteration_}, at::kLong);
+    c.tensors["trainer.rng_state"] = generator_.get_state();
+    c.metadata["options"] = options_to_yaml(options_);
+    write_checkpoint(run_dir_ / kCheckpoint, c);
+    write_metrics(run_dir_ / kMetrics, metrics_);
+    saved_iteration_ = iteration_;
+  }
+
+  void restore(const Checkpoint& c) {
+    model_.gaussians = gaussians_from_tensors(c.tensors, device_);
+    nn::load_module_tensors(*model_.network, c.tensors, run_dir_ / kCheckpoint, "network.");
+    register_parameters();
+    adam_.load_state(c.tensors);
+    const auto tensor = [&](const char* name) {
+      auto it = c.tensors.find(name);
+      if (it == c.tensors.end()) throw Error(run_dir_ / kCheckpoint, std::string("has no tensor '") + name + "'");
+      return it->second.to(device_);
+    };
+    stats_.grad_norm_sum = tensor("densify.gradient_norm_sum");
+    stats_.visible_count = tensor("densify.visible_count");
+    max_world_std_ = tensor("densify.max_world_std");
+    generator_.set_state(tensor("trainer.rng_state").cpu());
+    iteration_ = saved_iteration_ = c.iteration();
+    metrics_ = read_metrics(run_dir_ / kMetrics, iteration_);
+    spdlog::info("resumed {} at iteration {}", (run_dir_ / kCheckpoint).string(), iteration_);
+  }
+
+  double heldout_psnr() {
+    if (heldout_views_.empty()) return 0.0;
+    at::NoGradGuard no_grad;
+    double total = 0;
+    for (const View& v : heldout_views_) {
+      const Camera& camera = dataset_.rig.cameras[v.camera];
+      const auto& f = dataset_.frames[v.frame];
+      const at::Tensor rendered = render_view(model_, frame_input(v.frame), camera, phase(), background_,
+                                              options_.antialiased);
+      const Image8 image = read_image_u8(dataset_.image_path(camera.name, f.id));
+      const at::Tensor rgba =
+          at::from_blob(const_cast<uint8_t*>(image.pixels.data()), {image.height, image.width, 4}, at::kByte);
+      const at::Tensor target = composite_target(rgba.to(device_), background_);
+      total += -10.0 * std::log10(std::max((rendered - target).pow(2).mean().item<double>(), 1e-12));
+    }
+    return total / static_cast<double>(heldout_views_.size());
+  }
+
+  TrainOptions options_;
+  fs::path run_dir_;
+  at::Device device_;
+  Dataset dataset_;
+  AvatarModel model_;
+  Adam adam_;
+  std::vector<std::string> network_groups_;
+  at::Generator generator_;
+  splat::MeanGradientStats stats_;
+  at::Tensor max_world_std_;
+  at::Tensor background_;
+  std::optional<nn::VggPerceptualLoss> vgg_;
+  std::map<int, FrameInput> frames_;
+  std::vector<View> train_views_, heldout_views_;
+  std::vector<MetricRow> metrics_;
+  StepProfiler profiler_;
+  int64_t iteration_ = 0;
+  int64_t saved_iteration_ = 0;
+};
+
+}  // namespace
+
+TrainSummary train(const fs::path& dataset, const fs::path& run, TrainOptions options, bool resume, bool overwrite) {
+  at::set_num_threads(options.cpu_threads > 0 ? options.cpu_threads
+                                              : static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+  if (resume) {
+    if (!fs::exists(run / kCheckpoint)) throw Error(run, "has no checkpoint to resume from");
+  } else if (fs::exists(run / kCheckpoint) && !overwrite) {
+    throw Error(run, "already holds a run (pass --resume to continue it, or --force to start over)");
+  }
+  fs::create_directories(run);
+  write_text_atomic(run / kOptions, options_to_yaml(options));
+
+  Run training(dataset, run, options, resume);
+  TrainSummary summary = training.train();
+
+  const nlohmann::json report = {{"dataset", fs::absolute(dataset).string()},
+                                 {"iterations", summary.iterations},
+                                 {"gaussians", summary.gaussians},
+                                 {"final_loss", summary.final_loss},
+                                 {"train_psnr", summary.train_psnr},
+                                 {"heldout_psnr", summary.heldout_psnr},
+                                 {"seconds", summary.seconds},
+                                 {"checkpoint", kCheckpoint}};
+  write_text_atomic(run / "run.json", report.dump(2));
+  return summary;
+}
+
+}  // namespace tega::trainer

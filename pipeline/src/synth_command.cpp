@@ -1,0 +1,77 @@
+// `tega synth`: the virtual studio. Parses flags over an optional YAML
+// config and calls tega::synth::render_virtual_studio().
+
+#include <iostream>
+#include <memory>
+
+#include "commands.h"
+#include "tega/core/error.h"
+#include "tega/core/options.h"
+#include "tega/core/progress.h"
+#include "tega/synth/virtual_studio.h"
+
+namespace tega::cli {
+namespace {
+
+struct SynthArgs {
+  std::string out, config, head;
+  int cameras = 0, frames = 0, width = 0, height = 0, threads = 0;
+  int64_t seed = 0;
+  bool print_options = false, force = false;
+  CLI::Option *cameras_opt, *frames_opt, *width_opt, *height_opt, *seed_opt, *head_opt, *threads_opt;
+};
+
+synth::Options resolve_options(const SynthArgs& a) {
+  synth::Options o;
+  if (!a.config.empty()) load_options(o, a.config);
+  if (a.cameras_opt->count()) o.studio.cameras = a.cameras;
+  if (a.width_opt->count()) o.studio.width = a.width;
+  if (a.height_opt->count()) o.studio.height = a.height;
+  if (a.frames_opt->count()) o.frames = a.frames;
+  if (a.seed_opt->count()) o.seed = a.seed;
+  if (a.head_opt->count()) o.head = a.head;
+  if (a.threads_opt->count()) o.threads = a.threads;
+  return o;
+}
+
+void run(const SynthArgs& a) {
+  const synth::Options options = resolve_options(a);
+  if (a.print_options) {
+    std::cout << options_to_yaml(options);
+    return;
+  }
+  if (a.out.empty()) throw Error("tega synth: --out DIR is required");
+  const synth::SynthSummary s = synth::render_virtual_studio(options, a.out, a.force);
+  std::cout << "wrote " << s.root.string() << " in " << Progress::format_duration(s.seconds) << "\n"
+            << "  head:     " << s.head << "\n"
+            << "  cameras:  " << s.cameras << " at " << s.width << "x" << s.height << " (rig.json)\n";
+  for (const auto& t : s.takes)
+    std::cout << "  take:     " << t.name << " (" << t.kind << ", " << t.frames << " frames)  takes/" << t.name << "/\n";
+  if (s.calibration_skipped) std::cout << "  take:     calibration skipped (this build has no OpenCV)\n";
+  std::cout << "  images:   " << s.images << "\n"
+            << "  truth:    ground_truth/ (meshes, alpha, poses, expressions)\n"
+            << "  dataset:  dataset/ (" << s.dataset_frames << " frames)\n";
+}
+
+}  // namespace
+
+void add_synth_command(CLI::App& app) {
+  auto args = std::make_shared<SynthArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "synth", "Render a synthetic capture of a head in a virtual studio: takes, rig, ground truth and a dataset.");
+  cmd->add_option("--out", args->out, "Output directory (must not exist unless --force).");
+  args->cameras_opt = cmd->add_option("--cameras", args->cameras, "Number of cameras (default 13).");
+  args->frames_opt = cmd->add_option("--frames", args->frames, "Frames of each performance take (default 30).");
+  args->width_opt = cmd->add_option("--width", args->width, "Image width in pixels (default 512).");
+  args->height_opt = cmd->add_option("--height", args->height, "Image height in pixels (default 384).");
+  args->seed_opt = cmd->add_option("--seed", args->seed, "Seed of skin texture, motion, board poses and noise (default 1).");
+  args->head_opt = cmd->add_option("--head", args->head,
+                                   "Blendshape model directory laid out like ICT-FaceKit (default: the built-in head).");
+  args->threads_opt = cmd->add_option("--threads", args->threads, "Worker threads (default: one per hardware thread).");
+  cmd->add_option("--config", args->config, "YAML file of synth options (see --print-options); flags override it.");
+  cmd->add_flag("--print-options", args->print_options, "Print the resolved options as documented YAML and exit.");
+  cmd->add_flag("--force", args->force, "Replace an existing output directory.");
+  cmd->callback([args] { run(*args); });
+}
+
+}  // namespace tega::cli

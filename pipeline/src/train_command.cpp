@@ -1,0 +1,66 @@
+#include <iostream>
+#include <memory>
+#include <optional>
+
+#include "commands.h"
+#include "tega/core/error.h"
+#include "tega/core/options.h"
+#include "tega/trainer/trainer.h"
+
+namespace tega::cli {
+
+namespace {
+struct TrainArguments {
+  std::string data, out, config;
+  std::vector<std::string> overrides, ablations;
+  std::optional<int64_t> iterations;
+  std::optional<std::string> device;
+  bool resume = false, force = false, profile = false, print_options = false;
+};
+}  // namespace
+
+void add_train_command(CLI::App& app) {
+  auto args = std::make_shared<TrainArguments>();
+  auto* cmd = app.add_subcommand("train", "Train a TeGA avatar on a dataset (docs/training.md).");
+  cmd->add_option("--data", args->data, "Dataset directory (docs/layouts.md#dataset).");
+  cmd->add_option("--out", args->out, "Run directory: checkpoint, metrics, options (docs/layouts.md#run).");
+  cmd->add_option("--iterations", args->iterations, "Training iterations (default 60000; schedules scale with it).");
+  cmd->add_option("--device", args->device, "cpu or cuda (default cpu).");
+  cmd->add_option("--config", args->config, "YAML file of training options (see --print-options).");
+  cmd->add_option("--set", args->overrides, "Override one option, e.g. --set densify.max_gaussians=1000000 (repeatable).");
+  cmd->add_option("--ablation", args->ablations,
+                  "Paper Table 1 ablation: no-warp, no-shading, no-network, no-densify, ga-binding, mlp-only (repeatable).");
+  cmd->add_flag("--resume", args->resume, "Continue the run in --out from its checkpoint (its saved options apply; "
+                                          "--iterations and --device still override).");
+  cmd->add_flag("--force", args->force, "Start over even if --out already holds a run.");
+  cmd->add_flag("--profile", args->profile, "Report the time of each part of a step (slower).");
+  cmd->add_flag("--print-options", args->print_options, "Print every training option with its default and exit.");
+  cmd->callback([args] {
+    trainer::TrainOptions options;
+    if (args->resume) {
+      load_options(options, std::filesystem::path(args->out) / "options.yaml");
+    } else if (!args->config.empty()) {
+      load_options(options, args->config);
+    }
+    for (const auto& ablation : args->ablations) trainer::apply_ablation(options, ablation);
+    for (const auto& kv : args->overrides) {
+      const auto eq = kv.find('=');
+      if (eq == std::string::npos) throw Error("--set " + kv + ": expected key=value");
+      set_option(options, kv.substr(0, eq), kv.substr(eq + 1));
+    }
+    if (args->iterations) options.iterations = *args->iterations;
+    if (args->device) options.device = *args->device;
+    if (args->profile) options.profile = true;
+    if (args->print_options) {
+      std::cout << options_to_yaml(options);
+      return;
+    }
+    if (args->data.empty() || args->out.empty()) throw Error("tega train needs --data and --out");
+    const auto s = trainer::train(args->data, args->out, options, args->resume, args->force);
+    std::cout << "trained " << s.iterations << " iterations in " << s.seconds << " s: " << s.gaussians
+              << " Gaussians, loss " << s.final_loss << ", train PSNR " << s.train_psnr << " dB, held-out-camera PSNR "
+              << s.heldout_psnr << " dB\ncheckpoint: " << s.checkpoint.string() << "\n";
+  });
+}
+
+}  // namespace tega::cli
