@@ -1,0 +1,71 @@
+#include "tega/uvd/uvd_map.h"
+
+namespace tega::uvd {
+namespace {
+
+// Guards the normal's normalisation where the corner normals cancel out
+// (never on a sane mesh: it needs normals flipping across one triangle).
+constexpr double kMinNormalLength = 1e-12;
+
+// rows [N*3] of table [*,C] -> [N,3,C]
+at::Tensor corners_of(const at::Tensor& table, const at::Tensor& corner_index) {
+  return table.index_select(0, corner_index.reshape(-1)).view({corner_index.size(0), 3, table.size(1)});
+}
+
+}  // namespace
+
+at::Tensor vertex_normals(const at::Tensor& vertices, const at::Tensor& faces) {
+  const auto corners = corners_of(vertices, faces);
+  // The unnormalised cross product has length 2·area: area weighting for free.
+  const auto face_normal =
+      at::cross(corners.select(1, 1) - corners.select(1, 0), corners.select(1, 2) - corners.select(1, 0), 1);
+  const auto sum = at::zeros_like(vertices).index_add(0, faces.reshape(-1), face_normal.repeat_interleave(3, 0));
+  return sum / sum.norm(2, 1, /*keepdim=*/true).clamp_min(1e-30);
+}
+
+PosedMesh pose(const UvTriangleLookup& lookup, const at::Tensor& vertices) {
+  TORCH_CHECK(vertices.dim() == 2 && vertices.size(1) == 3, "pose: vertices must be [V,3]");
+  TORCH_CHECK(vertices.device() == lookup.device(), "pose: vertices and lookup on different devices");
+  return {vertices, vertex_normals(vertices, lookup.faces())};
+}
+
+UvdMapping uvd_to_world(const at::Tensor& uvd, const PosedMesh& mesh, const UvTriangleLookup& lookup,
+                        const at::Tensor& bound_triangle) {
+  TORCH_CHECK(uvd.dim() == 2 && uvd.size(1) == 3, "uvd_to_world: uvd must be [N,3]");
+  TORCH_CHECK(uvd.scalar_type() == mesh.vertices.scalar_type() && uvd.scalar_type() == mesh.normals.scalar_type(),
+              "uvd_to_world: uvd and the posed mesh must share a dtype");
+  const auto uv = uvd.slice(1, 0, 2);
+  const auto d = uvd.slice(1, 2, 3);  // [N,1]
+
+  at::Tensor triangle, valid_uv;
+  if (bound_triangle.defined()) {
+    TORCH_CHECK(bound_triangle.dim() == 1 && bound_triangle.size(0) == uvd.size(0),
+                "uvd_to_world: bound_triangle must be [N]");
+    triangle = bound_triangle.to(at::kLong);
+    valid_uv = uv;
+  } else {
+    const UvHit hit = lookup.lookup(uv);
+    triangle = hit.triangle;
+    // Value of the projected uv, gradient of the query (straight through).
+    valid_uv = uv + (hit.uv - uv).detach();
+  }
+
+  const auto b = lookup.barycentrics_in(valid_uv, triangle).unsqueeze(-1);  // [N,3,1]
+  const auto db = lookup.barycentric_gradient(uvd.scalar_type()).index_select(0, triangle);  // [N,3,2]
+  const auto corner_index = lookup.faces().index_select(0, triangle);
+  const auto v = corners_of(mesh.vertices, corner_index);  // [N,corner,xyz]
+  const auto nv = corners_of(mesh.normals, corner_index);
+
+  const auto position = (b * v).sum(1);  // [N,3]
+  const auto m = (b * nv).sum(1);
+  const auto m_length = m.norm(2, 1, /*keepdim=*/true).clamp_min(kMinNormalLength);
+  const auto n = m / m_length;
+
+  const auto dposition = v.transpose(1, 2).matmul(db);  // [N,3,2]
+  const auto dm = nv.transpose(1, 2).matmul(db);
+  const auto dn = (dm - n.unsqueeze(-1) * (n.unsqueeze(-1) * dm).sum(1, /*keepdim=*/true)) / m_length.unsqueeze(-1);
+  const auto jacobian = at::cat({dposition + d.unsqueeze(-1) * dn, n.unsqueeze(-1)}, 2);
+  return {position + d * n, jacobian, triangle};
+}
+
+}  // namespace tega::uvd
