@@ -7,12 +7,6 @@
 namespace tega::nn {
 namespace {
 
-std::string shape_string(at::IntArrayRef sizes) {
-  std::string s = "[";
-  for (size_t i = 0; i < sizes.size(); ++i) s += (i ? "," : "") + std::to_string(sizes[i]);
-  return s + "]";
-}
-
 template <class Visit>
 void for_each_tensor(const torch::nn::Module& module, Visit visit) {
   for (const auto& item : module.named_parameters(/*recurse=*/true)) visit(item.key(), item.value());
@@ -34,8 +28,8 @@ void load_module_tensors(torch::nn::Module& module, const TensorMap& tensors, co
     const auto it = tensors.find(prefix + name);
     if (it == tensors.end()) throw Error(source, "missing tensor '" + prefix + name + "'");
     if (it->second.sizes() != target.sizes())
-      throw Error(source, "tensor '" + prefix + name + "' has shape " + shape_string(it->second.sizes()) +
-                              ", the network expects " + shape_string(target.sizes()));
+      throw Error(source, "tensor '" + prefix + name + "' has shape " + c10::str(it->second.sizes()) +
+                              ", the network expects " + c10::str(target.sizes()));
     target.copy_(it->second);  // in place: the tensor handle is shared with the module
   });
 }

@@ -1,0 +1,77 @@
+#pragma once
+// The small conditioned MLPs of TeGA §3.4–3.5, evaluated per Gaussian (or per
+// random uvd sample):
+//
+//   y = L2(σ(L1(σ(L0([PE(uvd), f])))))      two hidden layers, σ = SiLU
+//
+// PE is a sinusoidal positional encoding of the (scaled) uvd position and f
+// the latent feature sampled at the Gaussian's uv (absent when the network
+// runs without latents). The last layer starts at zero, so a fresh field
+// outputs exactly 0 (and a zero Jacobian).
+//
+// forward_with_jacobian() also returns ∂y/∂uvd without double backward: three
+// tangent columns travel through the layers next to the activations
+// (J ← J·Wᵀ for a linear layer, J ← σ'(pre-activation)·J for the activation)
+// starting from the positional encoding's analytic derivative. The latent is
+// a condition: it is not differentiated w.r.t. uvd. All of it is plain tensor
+// algebra, so autograd differentiates the Jacobian too (the smoothness loss
+// and the covariance J Σ Jᵀ train the weights through it).
+//
+// SiLU rather than ReLU because J enters the Gaussians' covariances: with a
+// smooth activation the Jacobian is continuous in uvd and its gradient w.r.t.
+// the weights does not vanish in flat regions.
+
+#include <ATen/core/Tensor.h>
+#include <torch/nn/module.h>
+#include <torch/nn/modules/linear.h>
+#include <torch/nn/pimpl.h>
+
+#include <vector>
+
+namespace tega::nn {
+
+// PE(uvd) = [x, sin(2^k π x), cos(2^k π x)] for k = 0..frequencies-1, where
+// x = (u, v, depth_scale·d) with d in metres. depth_scale maps d to units
+// comparable with uv (1 unit of u spans roughly 0.3 m of face, so the
+// default 3 makes 1 unit of scaled d ≈ 0.33 m).
+struct PositionalEncoding {
+  int64_t frequencies = 6;
+  double depth_scale = 3.0;
+
+  int64_t channels() const { return 3 + 6 * frequencies; }
+  at::Tensor encode(const at::Tensor& uvd) const;  // [N,3] → [N,channels()]
+  // d encode / d uvd as [N, 3 (uvd), channels()]; row a is the tangent of uvd axis a.
+  at::Tensor jacobian(const at::Tensor& uvd) const;
+};
+
+struct FieldMLPOptions {
+  int64_t condition_channels = 64;  // 0: no latent condition
+  int64_t hidden = 64;
+  int64_t outputs = 3;
+  PositionalEncoding encoding;
+};
+
+struct FieldWithJacobian {
+  at::Tensor value;     // [N, outputs]
+  at::Tensor jacobian;  // [N, outputs, 3]: ∂value_i / ∂uvd_j
+};
+
+class FieldMLPImpl : public torch::nn::Module {
+ public:
+  explicit FieldMLPImpl(const FieldMLPOptions& options);
+
+  // uvd [N,3]; condition [N, condition_channels] (undefined when 0 channels).
+  at::Tensor forward(const at::Tensor& uvd, const at::Tensor& condition);
+  FieldWithJacobian forward_with_jacobian(const at::Tensor& uvd, const at::Tensor& condition);
+
+  const FieldMLPOptions& options() const { return options_; }
+
+ private:
+  at::Tensor first_layer_input(const at::Tensor& uvd, const at::Tensor& condition) const;
+
+  FieldMLPOptions options_;
+  torch::nn::Linear input_{nullptr}, hidden_{nullptr}, output_{nullptr};
+};
+TORCH_MODULE(FieldMLP);
+
+}  // namespace tega::nn

@@ -1,0 +1,132 @@
+#include "tega/nn/field_mlp.h"
+
+#include <ATen/ATen.h>
+#include <gtest/gtest.h>
+#include <torch/csrc/autograd/autograd.h>
+
+namespace tega::nn {
+namespace {
+
+at::Tensor random_uvd(int64_t n, at::ScalarType type = at::kDouble) {
+  at::Tensor uvd = at::rand({n, 3}, at::kDouble);
+  uvd.select(1, 2).mul_(0.25).sub_(0.05);  // d in [-0.05, 0.2] m
+  return uvd.to(type);
+}
+
+// A trained-looking MLP: the zero-initialised output layer randomised too.
+FieldMLP random_mlp(const FieldMLPOptions& options) {
+  FieldMLP mlp(options);
+  mlp->to(at::kDouble);
+  at::NoGradGuard no_grad;
+  for (auto& p : mlp->parameters()) p.normal_(0.0, 0.4);
+  return mlp;
+}
+
+// d y_i / d uvd by autograd, [N, outputs, 3].
+at::Tensor autograd_jacobian(FieldMLP& mlp, const at::Tensor& uvd, const at::Tensor& condition) {
+  const at::Tensor x = uvd.detach().requires_grad_(true);
+  const at::Tensor y = mlp->forward(x, condition);
+  std::vector<at::Tensor> rows;
+  for (int64_t i = 0; i < y.size(1); ++i)
+    rows.push_back(torch::autograd::grad({y.select(1, i).sum()}, {x}, {}, /*retain_graph=*/true)[0]);
+  return at::stack(rows, 1);
+}
+
+TEST(PositionalEncoding, JacobianMatchesAutograd) {
+  const PositionalEncoding pe{4, 3.0};
+  const at::Tensor uvd = random_uvd(7).requires_grad_(true);
+  const at::Tensor encoded = pe.encode(uvd);
+  ASSERT_EQ(encoded.sizes(), (std::vector<int64_t>{7, pe.channels()}));
+  const at::Tensor analytic = pe.jacobian(uvd.detach());
+  ASSERT_EQ(analytic.sizes(), (std::vector<int64_t>{7, 3, pe.channels()}));
+  for (int64_t p = 0; p < pe.channels(); ++p) {
+    const at::Tensor g = torch::autograd::grad({encoded.select(1, p).sum()}, {uvd}, {}, true)[0];  // [N,3]
+    EXPECT_TRUE(at::allclose(analytic.select(2, p), g, 1e-12, 1e-12)) << "feature " << p;
+  }
+}
+
+TEST(FieldMLP, StartsAsANullFieldWithZeroJacobian) {
+  FieldMLPOptions options;
+  options.condition_channels = 8;
+  FieldMLP mlp(options);
+  const at::Tensor uvd = random_uvd(20, at::kFloat);
+  const at::Tensor condition = at::randn({20, 8});
+  const FieldWithJacobian out = mlp->forward_with_jacobian(uvd, condition);
+  EXPECT_EQ(out.value.sizes(), (std::vector<int64_t>{20, 3}));
+  EXPECT_EQ(out.jacobian.sizes(), (std::vector<int64_t>{20, 3, 3}));
+  EXPECT_EQ(out.value.abs().max().item<float>(), 0.0f);
+  EXPECT_EQ(out.jacobian.abs().max().item<float>(), 0.0f);
+  // The hidden layers are not zero: only the output layer is.
+  EXPECT_GT(mlp->named_parameters()["hidden.weight"].abs().sum().item<float>(), 0.0f);
+}
+
+TEST(FieldMLP, TangentJacobianMatchesAutogradAndFiniteDifferences) {
+  FieldMLPOptions options;
+  options.condition_channels = 5;
+  options.hidden = 16;
+  FieldMLP mlp = random_mlp(options);
+  const at::Tensor uvd = random_uvd(9);
+  const at::Tensor condition = at::randn({9, 5}, at::kDouble);
+
+  const FieldWithJacobian out = mlp->forward_with_jacobian(uvd, condition);
+  EXPECT_TRUE(at::allclose(out.value, mlp->forward(uvd, condition), 1e-14, 1e-14));
+  EXPECT_GT(out.jacobian.abs().max().item<double>(), 1e-3);  // a non-trivial field
+  EXPECT_TRUE(at::allclose(out.jacobian, autograd_jacobian(mlp, uvd, condition), 1e-10, 1e-12));
+
+  const double h = 1e-6;
+  for (int64_t axis = 0; axis < 3; ++axis) {
+    at::Tensor step = at::zeros({1, 3}, at::kDouble);
+    step[0][axis] = h;
+    const at::Tensor fd = (mlp->forward(uvd + step, condition) - mlp->forward(uvd - step, condition)) / (2 * h);
+    EXPECT_TRUE(at::allclose(out.jacobian.select(2, axis), fd, 1e-6, 1e-8)) << "axis " << axis;
+  }
+}
+
+TEST(FieldMLP, JacobianWithoutConditionMatchesAutograd) {
+  FieldMLPOptions options;
+  options.condition_channels = 0;
+  options.outputs = 1;
+  FieldMLP mlp = random_mlp(options);
+  const at::Tensor uvd = random_uvd(6);
+  const FieldWithJacobian out = mlp->forward_with_jacobian(uvd, {});
+  EXPECT_EQ(out.jacobian.sizes(), (std::vector<int64_t>{6, 1, 3}));
+  EXPECT_TRUE(at::allclose(out.jacobian, autograd_jacobian(mlp, uvd, {}), 1e-10, 1e-12));
+}
+
+TEST(FieldMLP, SmoothnessGradientFlowsThroughTheJacobianToEveryLayer) {
+  FieldMLPOptions options;
+  options.condition_channels = 4;
+  options.hidden = 8;
+  FieldMLP mlp = random_mlp(options);
+  const at::Tensor uvd = random_uvd(5);
+  const at::Tensor condition = at::randn({5, 4}, at::kDouble);
+  const auto objective = [&] { return mlp->forward_with_jacobian(uvd, condition).jacobian.square().sum(); };
+
+  objective().backward();
+  for (const auto& name : {"input.weight", "hidden.weight", "hidden.bias", "output.weight"}) {
+    at::Tensor param = mlp->named_parameters()[name];
+    ASSERT_TRUE(param.grad().defined()) << name;
+    // Autograd through the tangent columns equals a finite difference of ‖J‖².
+    const at::Tensor flat = param.view(-1);
+    const int64_t index = flat.numel() / 2;
+    const double analytic = param.grad().view(-1)[index].item<double>();
+    const double h = 1e-6;
+    double values[2];
+    for (int s = 0; s < 2; ++s) {
+      at::NoGradGuard no_grad;
+      const double original = flat[index].item<double>();
+      flat[index] = original + (s ? -h : h);
+      values[s] = objective().item<double>();
+      flat[index] = original;
+    }
+    const double numeric = (values[0] - values[1]) / (2 * h);
+    EXPECT_NEAR(analytic, numeric, 1e-6 * std::max(1.0, std::abs(numeric))) << name;
+    EXPECT_NE(analytic, 0.0) << name;
+  }
+  // The output bias shifts the field but not its slope.
+  const at::Tensor bias_grad = mlp->named_parameters()["output.bias"].grad();
+  EXPECT_TRUE(!bias_grad.defined() || bias_grad.abs().max().item<double>() == 0.0);
+}
+
+}  // namespace
+}  // namespace tega::nn
