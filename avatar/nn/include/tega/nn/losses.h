@@ -1,0 +1,39 @@
+#pragma once
+// TeGA's training losses (§3.6, Eq. 6), except the VGG term (vgg_loss.h):
+//
+//   L = 0.8 L1 + 0.2 L_D-SSIM + λ_VGG L_VGG + λ_JD L_JD
+//
+// Images are [C,H,W] or [B,C,H,W] floats in [0,1].
+
+#include <ATen/core/Generator.h>
+#include <ATen/core/Tensor.h>
+
+
+namespace tega::nn {
+
+// Mean absolute difference.
+at::Tensor l1_image_loss(const at::Tensor& rendered, const at::Tensor& target);
+
+// Mean SSIM as in 3DGS: 11x11 Gaussian window (σ = 1.5) applied per channel
+// by conv2d with zero padding (so the output keeps the image size),
+// C1 = 0.01², C2 = 0.03² for a data range of 1.
+at::Tensor ssim(const at::Tensor& a, const at::Tensor& b);
+// 1 - SSIM, the form 3DGS weighs by 0.2 (not (1 - SSIM)/2).
+at::Tensor dssim_loss(const at::Tensor& rendered, const at::Tensor& target);
+
+// The deformation smoothness term, Eq. 8: ‖J_D‖_F² over random uvd samples.
+// The paper writes a sum over its 100K samples; with λ_JD starting at 1 that
+// would outweigh the photometric terms (≈ 0.05) by orders of magnitude, so the
+// caller chooses the normalisation explicitly and the trainer uses the mean
+// (a sum is the mean times the sample count, i.e. only a rescaled λ).
+enum class Reduction { mean, sum };
+at::Tensor jacobian_smoothness_loss(const at::Tensor& jacobians /* [N,3,3] */, Reduction reduction);
+
+// Uniform uvd samples [count,3] for the smoothness loss: u, v in [0,1],
+// d in [-0.05, 0.2] m (the paper's [-50, 200] mm).
+constexpr double kSmoothnessDepthMin = -0.05;
+constexpr double kSmoothnessDepthMax = 0.2;
+at::Tensor sample_smoothness_uvd(int64_t count, const at::TensorOptions& options,
+                                 c10::optional<at::Generator> generator = c10::nullopt);
+
+}  // namespace tega::nn
