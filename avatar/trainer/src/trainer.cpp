@@ -101,8 +101,7 @@ class Run {
     train_views_ = views_of(dataset_, dataset_.train.frames, dataset_.train.cameras);
     heldout_views_ = views_of(dataset_, dataset_.train.frames, dataset_.test.cameras);
     if (!options_.loss.vgg_weights.empty()) {
-      vgg_.emplace(nn::VggPerceptualLoss::load(options_.loss.vgg_weights));
-      vgg_->to(device_);
+      vgg_.emplace(nn::VggPerceptualLoss::load(options_.loss.vgg_weights).to(device_));
     } else {
       spdlog::info("perceptual (VGG) loss: off (no loss.vgg_weights configured)");
     }
@@ -207,7 +206,7 @@ class Run {
     profiler_.section("losses");
     const at::Tensor rendered = raster.rgb[0].permute({2, 0, 1});
     const at::Tensor target = composite_target(loaded.rgba.to(device_), background_);
-    at::Tensor loss = options_.loss.l1 * nn::l1_loss(rendered, target) +
+    at::Tensor loss = options_.loss.l1 * (rendered - target).abs().mean() +
                       options_.loss.dssim * nn::dssim_loss(rendered, target);
     const double vgg_weight = schedules::vgg_weight(options_.loss, iteration_, options_.iterations);
     if (vgg_ && vgg_weight > 0) loss = loss + vgg_weight * (*vgg_)(rendered.unsqueeze(0), target.unsqueeze(0));
