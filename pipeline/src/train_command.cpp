@@ -14,6 +14,7 @@ struct TrainArguments {
   std::string data, out, config;
   std::vector<std::string> overrides, ablations;
   std::optional<int64_t> iterations;
+  int64_t stop_at = 0;
   std::optional<std::string> device;
   bool resume = false, force = false, profile = false, print_options = false;
 };
@@ -32,6 +33,8 @@ void add_train_command(CLI::App& app) {
                   "Paper Table 1 ablation: no-warp, no-shading, no-network, no-densify, ga-binding, mlp-only (repeatable).");
   cmd->add_flag("--resume", args->resume, "Continue the run in --out from its checkpoint (its saved options apply; "
                                           "--iterations and --device still override).");
+  cmd->add_option("--stop-at", args->stop_at,
+                  "Stop with a checkpoint after this iteration; continue later with --resume.");
   cmd->add_flag("--force", args->force, "Start over even if --out already holds a run.");
   cmd->add_flag("--profile", args->profile, "Report the time of each part of a step (slower).");
   cmd->add_flag("--print-options", args->print_options, "Print every training option with its default and exit.");
@@ -56,7 +59,7 @@ void add_train_command(CLI::App& app) {
       return;
     }
     if (args->data.empty() || args->out.empty()) throw Error("tega train needs --data and --out");
-    const auto s = trainer::train(args->data, args->out, options, args->resume, args->force);
+    const auto s = trainer::train(args->data, args->out, options, {args->resume, args->force, args->stop_at});
     std::cout << "trained " << s.iterations << " iterations in " << s.seconds << " s: " << s.gaussians
               << " Gaussians, loss " << s.final_loss << ", train PSNR " << s.train_psnr << " dB, held-out-camera PSNR "
               << s.heldout_psnr << " dB\ncheckpoint: " << s.checkpoint.string() << "\n";

@@ -122,7 +122,8 @@ class Run {
                  dataset_.template_mesh.num_vertices(), model_.gaussians.size());
   }
 
-  TrainSummary train() {
+  TrainSummary train(int64_t stop_at) {
+    const int64_t last = stop_at > 0 ? std::min(stop_at, options_.iterations) : options_.iterations;
     ViewLoader loader(dataset_, train_views_, static_cast<uint64_t>(options_.seed), options_.loader_threads,
                       options_.prefetch);
     loader.seek(iteration_);
@@ -131,7 +132,7 @@ class Run {
     double window_loss = 0, window_psnr = 0;
     int window = 0;
     TrainSummary summary;
-    while (iteration_ < options_.iterations) {
+    while (iteration_ < last) {
       profiler_.section("data");
       const LoadedView view = loader.next();
       const auto [loss, mse] = step(view);
@@ -139,7 +140,7 @@ class Run {
       window_loss += loss;
       window_psnr += -10.0 * std::log10(std::max(mse, 1e-12));
       ++window;
-      if (iteration_ % options_.log_every == 0 || iteration_ == options_.iterations) {
+      if (iteration_ % options_.log_every == 0 || iteration_ == last) {
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         const double rate = static_cast<double>(iteration_ - first) / std::max(seconds, 1e-9);
         summary.final_loss = window_loss / window;
@@ -151,7 +152,7 @@ class Run {
         window_loss = window_psnr = 0;
         window = 0;
       }
-      if (iteration_ % options_.checkpoint_every == 0 && iteration_ < options_.iterations) save();
+      if (iteration_ % options_.checkpoint_every == 0 && iteration_ < last) save();
     }
     profiler_.stop();
     save();
@@ -372,19 +373,19 @@ class Run {
 
 }  // namespace
 
-TrainSummary train(const fs::path& dataset, const fs::path& run, TrainOptions options, bool resume, bool overwrite) {
+TrainSummary train(const fs::path& dataset, const fs::path& run, TrainOptions options, const RunControl& control) {
   at::set_num_threads(options.cpu_threads > 0 ? options.cpu_threads
                                               : static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
-  if (resume) {
+  if (control.resume) {
     if (!fs::exists(run / kCheckpoint)) throw Error(run, "has no checkpoint to resume from");
-  } else if (fs::exists(run / kCheckpoint) && !overwrite) {
+  } else if (fs::exists(run / kCheckpoint) && !control.overwrite) {
     throw Error(run, "already holds a run (pass --resume to continue it, or --force to start over)");
   }
   fs::create_directories(run);
   write_text_atomic(run / kOptions, options_to_yaml(options));
 
-  Run training(dataset, run, options, resume);
-  TrainSummary summary = training.train();
+  Run training(dataset, run, options, control.resume);
+  TrainSummary summary = training.train(control.stop_at);
 
   const nlohmann::json report = {{"dataset", fs::absolute(dataset).string()},
                                  {"iterations", summary.iterations},

@@ -24,12 +24,20 @@ struct TrainSummary {
   std::filesystem::path checkpoint;
 };
 
+struct RunControl {
+  // Continue from RUN/checkpoint.safetensors: parameters, optimizer, RNG and
+  // densification state, so the run goes on exactly as if uninterrupted.
+  bool resume = false;
+  // Without resume, an existing run is an error unless this is set.
+  bool overwrite = false;
+  // Stop with a checkpoint after this iteration (0: run to the end); the
+  // schedules still follow TrainOptions::iterations. For training in slices.
+  int64_t stop_at = 0;
+};
+
 // Validates the dataset before anything else (throws tega::Error naming the
-// offending file). With `resume`, continues from RUN/checkpoint.safetensors
-// with its parameters, optimizer state and RNG state, and the options saved
-// in the run (except `iterations`, which may be raised); without it, an
-// existing run directory is an error unless `overwrite`.
+// offending file), then trains.
 TrainSummary train(const std::filesystem::path& dataset, const std::filesystem::path& run, TrainOptions options,
-                   bool resume, bool overwrite);
+                   const RunControl& control);
 
 }  // namespace tega::trainer

@@ -1,0 +1,26 @@
+#include "tega/trainer/trained_avatar.h"
+
+#include "tega/core/error.h"
+#include "tega/core/options.h"
+#include "tega/nn/module_io.h"
+#include "tega/trainer/checkpoint.h"
+
+namespace tega::trainer {
+
+TrainedAvatar load_avatar(const std::filesystem::path& run, const Dataset& dataset, const at::Device& device) {
+  TrainOptions options;
+  load_options(options, run / "options.yaml");
+  const auto file = run / "checkpoint.safetensors";
+  if (!std::filesystem::exists(file)) throw Error(run, "has no checkpoint.safetensors (is it a training run?)");
+  const Checkpoint checkpoint = read_checkpoint(file);
+
+  TrainedAvatar avatar{options, AvatarModel(dataset, options, device), {}, checkpoint.iteration()};
+  avatar.model.gaussians = gaussians_from_tensors(checkpoint.tensors, device);
+  nn::load_module_tensors(*avatar.model.network, checkpoint.tensors, file, "network.");
+  avatar.phase.deformation = options.deformation_field;
+  avatar.phase.shading = options.dynamic_shading;
+  avatar.phase.sh_degree = options.sh_degree;
+  return avatar;
+}
+
+}  // namespace tega::trainer

@@ -1,0 +1,79 @@
+#include <ATen/ATen.h>
+#include <gtest/gtest.h>
+
+#include "tega/trainer/adam.h"
+#include "tega/trainer/spherical_harmonics.h"
+
+namespace {
+
+using tega::trainer::Adam;
+
+TEST(Adam, FirstStepMovesEachElementByTheLearningRate) {
+  at::Tensor p = at::tensor({1.0, -2.0, 3.0}, at::kDouble).requires_grad_(true);
+  Adam adam;
+  adam.add("p", p, 0.1);
+  (p * at::tensor({2.0, -5.0, 0.5}, at::kDouble)).sum().backward();
+  adam.step();
+  // Adam's first step is lr * sign(grad) (bias-corrected moments cancel).
+  EXPECT_TRUE(at::allclose(p.detach(), at::tensor({0.9, -1.9, 2.9}, at::kDouble), 1e-9, 1e-9)) << p;
+}
+
+TEST(Adam, StepScaleGivesPerColumnStepSizes) {
+  at::Tensor p = at::zeros({2, 3}, at::kDouble).requires_grad_(true);
+  Adam adam;
+  adam.add("p", p, 1.0, at::tensor({0.5, 0.5, 2.0}, at::kDouble).view({1, 3}));
+  p.sum().backward();
+  adam.step();
+  EXPECT_TRUE(at::allclose(adam.group("p").parameter.detach()[0], at::tensor({-0.5, -0.5, -2.0}, at::kDouble)));
+}
+
+TEST(Adam, ReplaceRowsKeepsMomentsOfKeptRowsAndZeroesNewOnes) {
+  at::Tensor p = at::arange(4, at::kDouble).view({4, 1}).requires_grad_(true);
+  Adam adam;
+  adam.add("p", p, 0.1);
+  (p * at::tensor({1.0, 2.0, 3.0, 4.0}, at::kDouble).view({4, 1})).sum().backward();
+  adam.step();
+  const at::Tensor m_before = adam.group("p").first_moment.clone();
+  const at::Tensor keep = at::tensor({3, 1}, at::kLong);
+  at::Tensor next = at::cat({p.detach().index_select(0, keep), at::zeros({2, 1}, at::kDouble)}).requires_grad_(true);
+  adam.replace_rows("p", next, keep, 2);
+  const at::Tensor m = adam.group("p").first_moment;
+  ASSERT_EQ(m.size(0), 4);
+  EXPECT_DOUBLE_EQ(m[0].item<double>(), m_before[3].item<double>());
+  EXPECT_DOUBLE_EQ(m[1].item<double>(), m_before[1].item<double>());
+  EXPECT_DOUBLE_EQ(m[2].item<double>(), 0.0);
+  EXPECT_TRUE(adam.group("p").parameter.is_same(next));
+}
+
+TEST(Adam, StateRoundTrips) {
+  at::Tensor p = at::ones({3}, at::kDouble).requires_grad_(true);
+  Adam a;
+  a.add("p", p, 0.1);
+  p.sum().backward();
+  a.step();
+  at::Tensor q = p.detach().clone().requires_grad_(true);
+  Adam b;
+  b.add("p", q, 0.1);
+  b.load_state(a.state());
+  EXPECT_EQ(b.steps(), 1);
+  EXPECT_TRUE(at::equal(b.group("p").second_moment, a.group("p").second_moment));
+}
+
+TEST(SphericalHarmonics, DegreeZeroIsTheOffsetDcTerm) {
+  const at::Tensor sh = at::zeros({2, 16, 3}, at::kDouble);
+  sh.select(1, 0).fill_(1.0);
+  const at::Tensor rgb = tega::trainer::sh_to_rgb(sh, at::randn({2, 3}, at::kDouble), 3);
+  EXPECT_TRUE(at::allclose(rgb, at::full({2, 3}, 0.5 + 0.28209479177387814, at::kDouble)));
+}
+
+TEST(SphericalHarmonics, DegreeOneFollowsTheViewDirection) {
+  // Coefficient 3 multiplies -c1 * x: looking along +x and -x gives opposite offsets.
+  const at::Tensor sh = at::zeros({2, 4, 3}, at::kDouble);
+  sh.select(1, 3).fill_(0.1);
+  const at::Tensor dirs = at::tensor({2.0, 0.0, 0.0, -3.0, 0.0, 0.0}, at::kDouble).view({2, 3});
+  const at::Tensor rgb = tega::trainer::sh_to_rgb(sh, dirs, 1);
+  EXPECT_NEAR(rgb[0][0].item<double>(), 0.5 - 0.4886025119029199 * 0.1, 1e-12);
+  EXPECT_NEAR(rgb[1][0].item<double>(), 0.5 + 0.4886025119029199 * 0.1, 1e-12);
+}
+
+}  // namespace

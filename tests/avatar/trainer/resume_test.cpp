@@ -1,0 +1,110 @@
+#include <ATen/ATen.h>
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+#include "tega/core/error.h"
+#include "tega/core/files.h"
+#include "tega/trainer/checkpoint.h"
+#include "tega/trainer/trainer.h"
+#include "test_support.h"
+
+namespace {
+
+using namespace tega::trainer;
+
+// Small enough for a few CPU iterations, yet every part of a step runs:
+// the warm-up ends at iteration 2 and densification runs every 2 iterations.
+TrainOptions tiny_options() {
+  TrainOptions o;
+  o.iterations = 6;
+  o.initial_gaussians = 64;
+  o.warmup = 2.0 / 6.0;
+  o.densify.start = 0.0;
+  o.densify.stop = 1.0;
+  o.densify.interval = 2.0 / 6.0;
+  o.densify.gradient_threshold = 0.0;  // densify every visible Gaussian
+  o.densify.opacity_reset_interval = 5.0 / 6.0;
+  o.loss.smoothness_samples = 32;
+  o.network.texture_size = 16;
+  o.network.unet_widths = {4, 8};
+  o.network.latent_channels = 4;
+  o.network.mlp_hidden = 8;
+  o.uv_lookup.resolution = 32;
+  o.checkpoint_every = 100;
+  o.log_every = 1;
+  o.loader_threads = 1;
+  o.prefetch = 2;
+  o.cpu_threads = 1;
+  return o;
+}
+
+TEST(Trainer, ResumeReproducesAnUninterruptedRun) {
+  tega::test::TempDir tmp;
+  tega::test::write_tiny_dataset(tmp / "data");
+  const TrainOptions options = tiny_options();
+
+  const TrainSummary straight = train(tmp / "data", tmp / "straight", options, {});
+  EXPECT_EQ(straight.iterations, 6);
+
+  const TrainSummary first = train(tmp / "data", tmp / "sliced", options, {.stop_at = 3});
+  EXPECT_EQ(first.iterations, 3);
+  const TrainSummary rest = train(tmp / "data", tmp / "sliced", options, {.resume = true});
+  EXPECT_EQ(rest.iterations, 6);
+  EXPECT_EQ(rest.gaussians, straight.gaussians);
+
+  const Checkpoint a = read_checkpoint(tmp / "straight/checkpoint.safetensors");
+  const Checkpoint b = read_checkpoint(tmp / "sliced/checkpoint.safetensors");
+  int compared = 0;
+  for (const auto& [name, tensor] : a.tensors) {
+    if (name.rfind("gaussians.", 0) != 0 && name.rfind("network.", 0) != 0) continue;
+    ASSERT_TRUE(b.tensors.count(name)) << name;
+    ASSERT_EQ(tensor.sizes(), b.tensors.at(name).sizes()) << name;
+    EXPECT_TRUE(at::allclose(tensor, b.tensors.at(name), 1e-5, 1e-7)) << name;
+    ++compared;
+  }
+  EXPECT_GE(compared, 10);
+  // The whole loss curve, before and after the interruption.
+  const auto losses = [](const std::filesystem::path& file) {
+    std::vector<double> values;
+    std::istringstream lines(tega::read_text_file(file));
+    std::string line;
+    std::getline(lines, line);  // header: iteration,loss,...
+    while (std::getline(lines, line)) values.push_back(std::stod(line.substr(line.find(',') + 1)));
+    return values;
+  };
+  const auto straight_losses = losses(tmp / "straight/metrics.csv");
+  const auto sliced_losses = losses(tmp / "sliced/metrics.csv");
+  ASSERT_EQ(straight_losses.size(), 6u);
+  ASSERT_EQ(sliced_losses.size(), 6u);
+  for (size_t i = 0; i < 6; ++i) EXPECT_NEAR(straight_losses[i], sliced_losses[i], 1e-5 * straight_losses[i]) << i;
+}
+
+TEST(Trainer, ExistingRunIsNotOverwrittenByAccident) {
+  tega::test::TempDir tmp;
+  tega::test::write_tiny_dataset(tmp / "data");
+  TrainOptions options = tiny_options();
+  options.iterations = 1;
+  train(tmp / "data", tmp / "run", options, {});
+  try {
+    train(tmp / "data", tmp / "run", options, {});
+    FAIL() << "expected an error";
+  } catch (const tega::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("already holds a run"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Trainer, BadDatasetFailsBeforeTraining) {
+  tega::test::TempDir tmp;
+  tega::test::write_tiny_dataset(tmp / "data");
+  std::filesystem::remove(tmp / "data/images/cam01/smile_000000.png");
+  try {
+    train(tmp / "data", tmp / "run", tiny_options(), {});
+    FAIL() << "expected an error";
+  } catch (const tega::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("cam01/smile_000000.png: is missing"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(tmp / "run/checkpoint.safetensors"));
+}
+
+}  // namespace

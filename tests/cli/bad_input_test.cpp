@@ -1,0 +1,56 @@
+// Bad input through the real `tega` binary: a message naming the file and
+// what is wrong, a non-zero exit, and nothing written.
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_support.h"
+#include "tega/core/files.h"
+#include "test_support.h"
+
+namespace {
+
+using tega::test::run_tega;
+
+TEST(CliBadInput, TruncatedKrtIsNamedWithItsLine) {
+  tega::test::TempDir tmp;
+  // One camera whose [R|t] block stops after its first row.
+  tega::test::write_text(tmp / "KRT",
+                         "400002\n1000 0 667 \n0 1000 1024 \n0 0 1 \n0 0 0 0 0\n1 0 0 10\n");
+  const auto r = run_tega("rig convert --in " + (tmp / "KRT").string() + " --width 1334 --height 2048 --out " +
+                          (tmp / "rig.json").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find((tmp / "KRT").string() + ": line"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(tmp / "rig.json"));
+}
+
+TEST(CliBadInput, FileThatIsNotAnImageIsNamed) {
+  tega::test::TempDir tmp;
+  tega::test::write_tiny_dataset(tmp.path());
+  const auto image = tmp / "images/cam00/smile_000000.png";
+  tega::test::write_text(image, "this is not a PNG file");
+  const auto r = run_tega("dataset check --data " + tmp.path().string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find(image.string() + ": is not a PNG image"), std::string::npos) << r.output;
+}
+
+TEST(CliRigConvert, KrtToJsonToColmapInMetres) {
+  tega::test::TempDir tmp;
+  tega::test::write_text(tmp / "KRT",
+                         "400002\n1000 0 667 \n0 1000 1024 \n0 0 1 \n0 0 0 0 0\n"
+                         "1 0 0 10\n0 1 0 20\n0 0 1 1000\n\n");
+  const auto json = run_tega("rig convert --in " + (tmp / "KRT").string() + " --width 1334 --height 2048 --out " +
+                             (tmp / "rig.json").string());
+  ASSERT_EQ(json.exit_code, 0) << json.output;
+  const auto colmap =
+      run_tega("rig convert --in " + (tmp / "rig.json").string() + " --out " + (tmp / "colmap").string() + "/");
+  ASSERT_EQ(colmap.exit_code, 0) << colmap.output;
+  EXPECT_TRUE(std::filesystem::exists(tmp / "colmap/cameras.txt"));
+  const auto rig = nlohmann::json::parse(tega::read_text_file(tmp / "rig.json"));
+  const auto t = rig["cameras"][0]["t"].get<std::vector<double>>();  // millimetres -> metres
+  EXPECT_NEAR(t[0], 0.01, 1e-12);
+  EXPECT_NEAR(t[2], 1.0, 1e-12);
+}
+
+}  // namespace
