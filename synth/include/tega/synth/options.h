@@ -1,0 +1,96 @@
+#pragma once
+// Options of the virtual studio (`tega synth`). Defaults equal
+// studio_configs/studio13.yaml, which a test keeps in sync.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace tega::synth {
+
+// The camera rig: cameras spread evenly over a spherical cap in front of the
+// head, all looking at the head's centre.
+struct StudioOptions {
+  int cameras = 13;
+  int width = 512;
+  int height = 384;
+  double distance_m = 1.0;
+  double focal_length_mm = 70.0;
+  double sensor_width_mm = 36.0;
+  double cap_half_angle_deg = 60.0;
+  std::vector<double> distortion = {-0.06, 0.09, 0.0004, -0.0003, 0.0};
+  double distortion_spread = 0.25;
+  double principal_point_spread = 0.01;
+
+  template <class V>
+  void visit(V& v) {
+    v("cameras", cameras, "Number of cameras (1 or more), placed by the layout generator.");
+    v("width", width, "Image width in pixels.");
+    v("height", height, "Image height in pixels.");
+    v("distance_m", distance_m, "Distance from each camera to the head's centre, metres.");
+    v("focal_length_mm", focal_length_mm, "Lens focal length, millimetres.");
+    v("sensor_width_mm", sensor_width_mm,
+      "Sensor width, millimetres (square pixels: the height follows from the image's aspect).");
+    v("cap_half_angle_deg", cap_half_angle_deg,
+      "Half-angle of the spherical cap in front of the face that the cameras cover, degrees.");
+    v("distortion", distortion, "Lens distortion k1, k2, p1, p2, k3 (OpenCV's model) of a typical camera.");
+    v("distortion_spread", distortion_spread,
+      "Relative per-camera variation of the distortion coefficients (0 = all lenses equal).");
+    v("principal_point_spread", principal_point_spread,
+      "Per-camera offset of the principal point from the image centre, as a fraction of the width.");
+  }
+};
+
+struct Options {
+  StudioOptions studio;
+  int frames = 30;
+  int calibration_frames = 16;
+  int64_t seed = 1;
+  std::string head;
+  double head_metres_per_unit = 0.01;
+  std::vector<int> head_eyeball_polygons;
+  std::vector<std::string> takes = {"expressions", "speech", "freestyle"};
+  std::vector<std::string> test_takes = {"freestyle"};
+  int test_cameras = 2;
+  double fps = 30.0;
+  int supersampling = 3;
+  int fine_subdivisions = 2;
+  double wrinkle_depth_m = 0.0012;
+  double crease_darkening = 0.5;
+  double noise_sigma = 0.004;
+  bool write_fine_meshes = true;
+  int threads = 0;
+
+  template <class V>
+  void visit(V& v) {
+    v("studio", studio, "The virtual camera rig.");
+    v("frames", frames, "Frames of each performance take.");
+    v("calibration_frames", calibration_frames,
+      "Frames of the calibration take (ChArUco board poses; needs OpenCV, skipped without it).");
+    v("seed", seed, "Seed of everything random: skin texture, head motion, board poses, sensor noise.");
+    v("head", head,
+      "Blendshape model directory laid out like ICT-FaceKit; empty = the built-in procedural head.");
+    v("head_metres_per_unit", head_metres_per_unit,
+      "Units of the `head` model's files (ICT-FaceKit: 0.01, centimetres).");
+    v("head_eyeball_polygons", head_eyeball_polygons,
+      "First and last polygon index of the `head` model's eyeballs; empty = ICT-FaceKit's "
+      "[21496, 24691] when the model has ICT-FaceKit's topology.");
+    v("takes", takes, "Performance takes to render, by script name: expressions, speech, freestyle.");
+    v("test_takes", test_takes, "Performance takes whose frames form the dataset's test split.");
+    v("test_cameras", test_cameras,
+      "Cameras held out for the dataset's test split (clamped to 1 .. cameras - 1).");
+    v("fps", fps, "Frame rate written into take.json (scripts span the take whatever its frame count).");
+    v("supersampling", supersampling, "Samples per pixel along each axis (antialiasing).");
+    v("fine_subdivisions", fine_subdivisions,
+      "Subdivision levels from the coarse (tracked) mesh to the rendered fine mesh (each x4 triangles).");
+    v("wrinkle_depth_m", wrinkle_depth_m, "Depth of the expression wrinkles at full activation, metres.");
+    v("crease_darkening", crease_darkening,
+      "Shading loss at the bottom of a fully formed wrinkle (0 = none, 1 = black).");
+    v("noise_sigma", noise_sigma, "Standard deviation of sensor noise, in [0, 1] intensity units.");
+    v("write_fine_meshes", write_fine_meshes,
+      "Write the fine (rendered) mesh of every frame into ground_truth/ (large for long takes).");
+    v("threads", threads, "Worker threads; 0 = one per hardware thread.");
+  }
+};
+
+}  // namespace tega::synth

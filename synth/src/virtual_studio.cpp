@@ -1,0 +1,179 @@
+#include "tega/synth/virtual_studio.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <set>
+
+#include "studio.h"
+#include "tega/core/error.h"
+#include "tega/core/files.h"
+#include "tega/core/options.h"
+#include "tega/synth/charuco_board.h"
+#include "tega/synth/performance.h"
+#include "tega/synth/studio_rig.h"
+
+namespace tega::synth {
+namespace {
+
+// Held-out cameras spread over the layout rather than bunched together.
+std::vector<std::string> pick_test_cameras(const Rig& rig, int wanted) {
+  const int n = static_cast<int>(rig.cameras.size());
+  const int count = n == 1 ? 1 : std::clamp(wanted, 1, n - 1);
+  std::vector<std::string> out;
+  for (int i = 0; i < count; ++i) out.push_back(rig.cameras[(n - 1) - i * (n / count) % n].name);
+  return out;
+}
+
+void write_head_ground_truth(const std::filesystem::path& dir, const Head& head, const FineMeshMaker& maker) {
+  std::filesystem::create_directories(dir);
+  write_obj(head.model.neutral, dir / "template.obj");
+  write_obj(maker.fine_topology(), dir / "fine_topology.obj");
+  nlohmann::json wrinkles = nlohmann::json::array();
+  for (const auto& w : head.wrinkles)
+    wrinkles.push_back({{"name", w.name},
+                        {"drivers", w.drivers},
+                        {"centre", {w.centre.x(), w.centre.y()}},
+                        {"sigma", {w.sigma.x(), w.sigma.y()}},
+                        {"angle", w.angle},
+                        {"period", w.period}});
+  const auto vec = [](const Eigen::Vector3d& v) { return nlohmann::json{v.x(), v.y(), v.z()}; };
+  const nlohmann::json j = {
+      {"source", head.source},
+      {"template", "template.obj"},
+      {"fine_topology", "fine_topology.obj"},
+      {"fine_note", "fine meshes: fine_topology.obj's faces and UVs; each fine triangle's OBJ polygon is the "
+                    "coarse triangle it subdivides"},
+      {"eyeball_faces", head.eyeball_faces},
+      {"expressions", head.model.expression_names},
+      {"eye_left", vec(head.frame.eye_left)},
+      {"eye_right", vec(head.frame.eye_right)},
+      {"interocular_m", head.frame.interocular},
+      {"pivot", vec(head.pivot)},
+      {"wrinkle_regions", wrinkles}};
+  write_text_atomic(dir / "head.json", j.dump(2) + "\n");
+}
+
+}  // namespace
+
+void validate_options(const Options& o) {
+  make_studio_rig(o.studio);  // throws for a bad studio
+  if (o.frames < 1) throw Error("frames must be at least 1");
+  if (o.calibration_frames < 0) throw Error("calibration_frames must not be negative");
+  if (o.supersampling < 1 || o.supersampling > 8) throw Error("supersampling must be in 1 .. 8");
+  if (o.fine_subdivisions < 0 || o.fine_subdivisions > 4) throw Error("fine_subdivisions must be in 0 .. 4");
+  if (o.takes.empty()) throw Error("takes must name at least one performance script");
+  std::set<std::string> seen;
+  for (const auto& t : o.takes) {
+    if (!is_performance_script(t)) throw Error("takes: unknown performance script '" + t + "' (known: expressions, speech, freestyle)");
+    if (!seen.insert(t).second) throw Error("takes: '" + t + "' is listed twice");
+  }
+  for (const auto& t : o.test_takes)
+    if (!seen.count(t)) throw Error("test_takes: '" + t + "' is not one of takes");
+  if (o.test_takes.size() >= o.takes.size()) throw Error("test_takes must leave at least one take for training");
+  if (o.noise_sigma < 0 || o.wrinkle_depth_m < 0 || o.crease_darkening < 0)
+    throw Error("noise_sigma, wrinkle_depth_m and crease_darkening must not be negative");
+}
+
+Head make_head(const Options& o) {
+  if (o.head.empty()) return make_procedural_head();
+  return load_head(o.head, o.head_metres_per_unit, o.head_eyeball_polygons);
+}
+
+SynthSummary render_virtual_studio(const Options& o, const std::filesystem::path& out, bool replace_existing) {
+  const auto start = std::chrono::steady_clock::now();
+  validate_options(o);
+  StagedDirectory staged(out, replace_existing);
+  const std::filesystem::path root = staged.path();
+
+  const Head head = make_head(o);
+  const FineMeshMaker maker(head, {o.fine_subdivisions, o.wrinkle_depth_m, o.crease_darkening});
+  const Rig rig = make_studio_rig(o.studio);
+  const Appearance appearance(uint64_t(o.seed));
+  const Backdrop backdrop(uint64_t(o.seed));
+  const HeadShader shader(head, maker, appearance);
+  ThreadPool pool(o.threads);
+  spdlog::info("synth: {} head ({} vertices, {} fine triangles), {} cameras at {}x{}", head.source,
+               head.model.num_vertices(), maker.fine_topology().num_faces(), rig.cameras.size(), o.studio.width,
+               o.studio.height);
+
+  const bool calibration = o.calibration_frames > 0 && charuco_texture_available();
+  if (o.calibration_frames > 0 && !calibration)
+    spdlog::warn("synth: built without OpenCV: the calibration take is skipped");
+  const int n_cameras = static_cast<int>(rig.cameras.size());
+  const int64_t total = n_cameras * (1 + (calibration ? o.calibration_frames : 0) +
+                                     int64_t(o.frames) * static_cast<int64_t>(o.takes.size()));
+  Progress progress("synth", total, "images");
+
+  std::vector<ImageF> backgrounds(n_cameras);
+  pool.parallel_for(0, n_cameras, [&](int64_t c) { backgrounds[c] = backdrop.render(rig.cameras[c]); });
+  const Studio studio{o, root, head, maker, rig, appearance, shader, backgrounds, pool, progress};
+
+  write_rig_json(rig, root / "rig.json");
+  write_head_ground_truth(root / "ground_truth" / "head", head, maker);
+
+  SynthSummary summary;
+  summary.root = out;
+  summary.head = head.source;
+  summary.cameras = n_cameras;
+  summary.width = o.studio.width;
+  summary.height = o.studio.height;
+  summary.calibration_skipped = o.calibration_frames > 0 && !calibration;
+
+  render_clean_plate(studio);
+  summary.takes.push_back({"clean_plate", "clean_plate", 1});
+  if (calibration) {
+    render_calibration(studio, "calibration");
+    summary.takes.push_back({"calibration", "calibration", o.calibration_frames});
+  }
+
+  Dataset dataset;
+  dataset.root = root / "dataset";
+  dataset.rig = rig;
+  for (Camera& cam : dataset.rig.cameras) cam.distortion = {};  // its images are undistorted
+  dataset.template_mesh = head.model.neutral;
+  dataset.eyeball_faces = head.eyeball_faces;
+  for (const auto& take : o.takes) {
+    std::vector<DatasetFrame> frames;
+    render_performance(studio, take, dataset, frames);
+    const bool test = std::find(o.test_takes.begin(), o.test_takes.end(), take) != o.test_takes.end();
+    for (const auto& f : frames) (test ? dataset.test : dataset.train).frames.push_back(f.id);
+    dataset.frames.insert(dataset.frames.end(), frames.begin(), frames.end());
+    summary.takes.push_back({take, "performance", o.frames});
+  }
+  dataset.test.cameras = pick_test_cameras(rig, o.test_cameras);
+  for (const auto& name : rig.camera_names())
+    if (std::find(dataset.test.cameras.begin(), dataset.test.cameras.end(), name) == dataset.test.cameras.end() ||
+        n_cameras == 1)
+      dataset.train.cameras.push_back(name);
+  write_dataset_manifest(dataset);
+  progress.finish();
+
+  nlohmann::json takes = nlohmann::json::array();
+  for (const auto& t : summary.takes) takes.push_back({{"name", t.name}, {"kind", t.kind}, {"frames", t.frames}});
+  const nlohmann::json capture = {
+      {"format", "tega-capture"},
+      {"version", 1},
+      {"generator", std::string("tega synth ") + TEGA_VERSION},
+      {"seed", o.seed},
+      {"head", head.source},
+      {"cameras", rig.camera_names()},
+      {"width", o.studio.width},
+      {"height", o.studio.height},
+      {"takes", takes},
+      {"calibration_skipped", summary.calibration_skipped},
+      {"rig", "rig.json"},
+      {"ground_truth", "ground_truth"},
+      {"dataset", "dataset"},
+      {"options", options_to_yaml(o)}};
+  write_text_atomic(root / "capture.json", capture.dump(2) + "\n");
+  staged.commit();
+
+  summary.images = total;
+  summary.dataset_frames = static_cast<int>(dataset.frames.size());
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+}  // namespace tega::synth
