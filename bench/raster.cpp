@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 #if defined(TEGA_TORCH_HAS_CUDA)
@@ -114,9 +115,34 @@ Result measure(int64_t n, int width, int height) {
   return r;
 }
 
+// `raster_bench profile N WIDTH HEIGHT` runs two untimed forward+backward
+// passes of one size, for a profiler (ncu) to time each kernel.
+int profile(int64_t n, int width, int height) {
+  const Scene s = head_scene(n, width, height);
+  RasterCamera camera;
+  camera.translation = {0.0, 0.0, 1.0};
+  camera.fx = camera.fy = 2.0 * width;
+  camera.cx = 0.5 * width;
+  camera.cy = 0.5 * height;
+  RasterSettings settings;
+  settings.width = width;
+  settings.height = height;
+  for (int i = 0; i < 2; ++i) {
+    const RasterOutput out = rasterize(s.means, s.covariances, s.sh, s.opacities, s.background, {camera}, settings);
+    const at::Tensor loss = (out.rgb - s.target).abs().mean();
+    torch::autograd::grad({loss}, {s.means, s.covariances, s.sh, s.opacities, s.background});
+  }
+  cudaDeviceSynchronize();
+  return 0;
+}
+
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
+  if (argc == 5 && std::string(argv[1]) == "profile") {
+    if (!at::hasCUDA()) return 1;
+    return profile(std::stoll(argv[2]), std::stoi(argv[3]), std::stoi(argv[4]));
+  }
   if (!at::hasCUDA()) {
     std::printf("raster_bench: no CUDA device, nothing to measure\n");
     return 0;

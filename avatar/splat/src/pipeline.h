@@ -116,8 +116,7 @@ TEGA_HD void project_backward_one(const RasterInputs<T>& in, const int32_t* radi
   const int64_t n = in.num_gaussians;
   const bool sh = in.sh_coefficients > 0;
   T* grad_sh = sh ? out.colors + int64_t(3) * in.sh_coefficients * g : nullptr;
-  if (sh)
-    for (int k = 0; k < 3 * in.sh_coefficients; ++k) grad_sh[k] = T(0);
+  bool sh_written = false;  // the first camera writes grad_sh, later ones add
   T grad_rgb_shared[3] = {T(0), T(0), T(0)};
   T stat_norm = T(0);
   int32_t stat_visible = 0;
@@ -138,8 +137,9 @@ TEGA_HD void project_backward_one(const RasterInputs<T>& in, const int32_t* radi
     if (sh) {
       const T direction[3] = {mean[0] - cam.centre[0], mean[1] - cam.centre[1], mean[2] - cam.centre[2]};
       T grad_direction[3];
-      sh_to_rgb_backward(in.sh_degree, in.colors + int64_t(3) * in.sh_coefficients * g, direction, grad_rgb,
-                         grad_sh, grad_direction);
+      sh_to_rgb_backward(in.sh_degree, in.sh_coefficients, in.colors + int64_t(3) * in.sh_coefficients * g,
+                         direction, grad_rgb, sh_written, grad_sh, grad_direction);
+      sh_written = true;
       for (int k = 0; k < 3; ++k) grad_mean[k] += grad_direction[k];
     } else if (in.color_camera_stride == 0) {
       for (int ch = 0; ch < 3; ++ch) grad_rgb_shared[ch] += grad_rgb[ch];
@@ -150,6 +150,8 @@ TEGA_HD void project_backward_one(const RasterInputs<T>& in, const int32_t* radi
   for (int k = 0; k < 3; ++k) out.means[3 * g + k] = grad_mean[k];
   for (int k = 0; k < 6; ++k) out.covariances[6 * g + k] = grad_cov[k];
   out.opacities[g] = grad_opacity;
+  if (sh && !sh_written)
+    for (int k = 0; k < 3 * in.sh_coefficients; ++k) grad_sh[k] = T(0);
   if (!sh && in.color_camera_stride == 0)
     for (int ch = 0; ch < 3; ++ch) out.colors[3 * g + ch] = grad_rgb_shared[ch];
   if (out.mean2d_grad_norm_sum) {

@@ -34,13 +34,15 @@ class TorchWorkspace final : public cuda::Workspace {
 
 Splat2D<float>* splat_ptr(const at::Tensor& t) { return reinterpret_cast<Splat2D<float>*>(t.data_ptr<float>()); }
 
-// Camera parameters copied to the device; the tensor keeps them alive.
+// Camera parameters copied to the device through pinned memory, so the copy
+// does not wait for the work already queued on the stream.
 at::Tensor device_cameras(const CallConfig& config, at::Device device) {
   const auto params = camera_params<float>(config.cameras);
   const int64_t width = sizeof(CameraParams<float>) / sizeof(float);
-  at::Tensor host = at::empty({int64_t(params.size()), width}, at::TensorOptions().dtype(at::kFloat));
+  at::Tensor host =
+      at::empty({int64_t(params.size()), width}, at::TensorOptions().dtype(at::kFloat).pinned_memory(true));
   std::memcpy(host.data_ptr<float>(), params.data(), params.size() * sizeof(CameraParams<float>));
-  return host.to(device);
+  return host.to(at::TensorOptions().device(device), /*non_blocking=*/true);
 }
 
 const CameraParams<float>* camera_ptr(const at::Tensor& t) {

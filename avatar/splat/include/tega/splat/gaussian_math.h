@@ -11,9 +11,13 @@
 
 #if defined(__CUDACC__)
 #define TEGA_HD __host__ __device__ __forceinline__
+// Fully unrolled loops index register arrays with constants, keeping them
+// out of local memory.
+#define TEGA_UNROLL _Pragma("unroll")
 #else
 #include <cmath>
 #define TEGA_HD inline
+#define TEGA_UNROLL
 #endif
 
 namespace tega::splat {
@@ -207,38 +211,52 @@ TEGA_HD void sh_to_rgb(int degree, const T* sh, const T* direction, T* rgb) {
   T basis[kMaxShCoefficients];
   sh_basis<T, T>(degree, direction[0] * inv, direction[1] * inv, direction[2] * inv, basis);
   const int count = (degree + 1) * (degree + 1);
-  for (int ch = 0; ch < 3; ++ch) {
-    T sum = T(0.5);
-    for (int b = 0; b < count; ++b) sum += basis[b] * sh[3 * b + ch];
-    rgb[ch] = math_max(sum, T(0));
-  }
+  T sum[3] = {T(0.5), T(0.5), T(0.5)};
+  TEGA_UNROLL
+  for (int b = 0; b < kMaxShCoefficients; ++b)
+    if (b < count)
+      for (int ch = 0; ch < 3; ++ch) sum[ch] += basis[b] * sh[3 * b + ch];
+  for (int ch = 0; ch < 3; ++ch) rgb[ch] = math_max(sum[ch], T(0));
 }
 
-// Backward of sh_to_rgb: adds d loss / d sh to grad_sh and returns
-// d loss / d direction in grad_direction. Channels clamped at 0 pass nothing.
+// Backward of sh_to_rgb for `coefficients` stored SH coefficients: writes
+// (or, with accumulate, adds) d loss / d sh to grad_sh and returns d loss /
+// d direction in grad_direction. Channels clamped at 0 pass nothing.
 template <typename T>
-TEGA_HD void sh_to_rgb_backward(int degree, const T* sh, const T* direction, const T* grad_rgb,
-                                T* grad_sh, T* grad_direction) {
+TEGA_HD void sh_to_rgb_backward(int degree, int coefficients, const T* sh, const T* direction, const T* grad_rgb,
+                                bool accumulate, T* grad_sh, T* grad_direction) {
   const T dir2 = direction[0] * direction[0] + direction[1] * direction[1] + direction[2] * direction[2];
   const T norm = math_sqrt(dir2);
   grad_direction[0] = grad_direction[1] = grad_direction[2] = T(0);
-  if (!(norm > T(0))) return;
+  if (!(norm > T(0))) {  // the camera sits on the mean: no colour gradient
+    if (!accumulate)
+      for (int k = 0; k < 3 * coefficients; ++k) grad_sh[k] = T(0);
+    return;
+  }
   const T inv = T(1) / norm;
   const T unit[3] = {direction[0] * inv, direction[1] * inv, direction[2] * inv};
   Dual3<T> x{unit[0], {T(1), T(0), T(0)}}, y{unit[1], {T(0), T(1), T(0)}}, z{unit[2], {T(0), T(0), T(1)}};
   Dual3<T> basis[kMaxShCoefficients];
   sh_basis<T, Dual3<T>>(degree, x, y, z, basis);
   const int count = (degree + 1) * (degree + 1);
+  T sum[3] = {T(0.5), T(0.5), T(0.5)};
+  TEGA_UNROLL
+  for (int b = 0; b < kMaxShCoefficients; ++b)
+    if (b < count)
+      for (int ch = 0; ch < 3; ++ch) sum[ch] += basis[b].v * sh[3 * b + ch];
   T grad_pass[3];
-  for (int ch = 0; ch < 3; ++ch) {
-    T sum = T(0.5);
-    for (int b = 0; b < count; ++b) sum += basis[b].v * sh[3 * b + ch];
-    grad_pass[ch] = sum < T(0) ? T(0) : grad_rgb[ch];
-  }
+  for (int ch = 0; ch < 3; ++ch) grad_pass[ch] = sum[ch] < T(0) ? T(0) : grad_rgb[ch];
   T grad_unit[3] = {T(0), T(0), T(0)};
-  for (int b = 0; b < count; ++b) {
+  TEGA_UNROLL
+  for (int b = 0; b < kMaxShCoefficients; ++b) {
+    if (b >= coefficients) break;
+    const bool used = b < count;
+    for (int ch = 0; ch < 3; ++ch) {
+      const T value = used ? basis[b].v * grad_pass[ch] : T(0);
+      grad_sh[3 * b + ch] = accumulate ? grad_sh[3 * b + ch] + value : value;
+    }
+    if (!used) continue;
     const T weight = grad_pass[0] * sh[3 * b] + grad_pass[1] * sh[3 * b + 1] + grad_pass[2] * sh[3 * b + 2];
-    for (int ch = 0; ch < 3; ++ch) grad_sh[3 * b + ch] += basis[b].v * grad_pass[ch];
     for (int k = 0; k < 3; ++k) grad_unit[k] += weight * basis[b].d[k];
   }
   // d unit / d direction = (I - unit unitᵀ) / norm
