@@ -1,0 +1,95 @@
+// `tega ingest multiface`: a Multiface capture -> tega's native dataset
+// (docs/multiface.md).
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <sstream>
+
+#include "commands.h"
+#include "tega/core/error.h"
+#include "tega/core/options.h"
+#include "tega/ingest/multiface.h"
+
+namespace tega::cli {
+
+namespace {
+struct MultifaceArguments {
+  std::string capture, out, config, template_obj, matte;
+  std::vector<std::string> overrides, cameras, test_cameras, expressions, test_expressions;
+  std::optional<int> frames, test_frames, downsample, threads;
+  bool force = false, print_options = false;
+};
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string text;
+  for (const auto& n : names) text += (text.empty() ? "" : " ") + n;
+  return text;
+}
+}  // namespace
+
+void add_ingest_command(CLI::App& app) {
+  auto* ingest = app.add_subcommand("ingest", "Turn an external capture into a tega dataset (docs/layouts.md#dataset).");
+  ingest->require_subcommand(1);
+
+  auto args = std::make_shared<MultifaceArguments>();
+  auto* cmd = ingest->add_subcommand(
+      "multiface",
+      "Multiface capture (KRT, frame_list.txt, images/, tracked_mesh/) -> dataset: rig in metres without distortion, "
+      "undistorted RGBA images matted by the mesh silhouette, world-space meshes, head poses, train/test split "
+      "(docs/multiface.md).");
+  cmd->add_option("--capture", args->capture, "Multiface capture directory (holds KRT and frame_list.txt).");
+  cmd->add_option("--out", args->out, "Dataset directory to write; appears only once complete.");
+  cmd->add_option("--config", args->config, "YAML file whose `ingest` section sets options (see --print-options).");
+  cmd->add_option("--set", args->overrides, "Override one option, e.g. --set matte_dilation_px=60 (repeatable).");
+  cmd->add_option("--cameras", args->cameras,
+                  "Cameras to use, by KRT name (default: all but those behind or directly above the head).");
+  cmd->add_option("--test-cameras", args->test_cameras,
+                  "Held-out cameras (default: 3 spread horizontally in front of the face).");
+  cmd->add_option("--expressions", args->expressions, "Expression sequences to use (default: all in frame_list.txt).");
+  cmd->add_option("--test-expressions", args->test_expressions,
+                  "Name prefixes of the held-out sequences (default: EXP_ROM EXP_free_face).");
+  cmd->add_option("--frames", args->frames, "Training frames, sampled uniformly (default 400).");
+  cmd->add_option("--test-frames", args->test_frames,
+                  "Test frames, sampled uniformly from the held-out sequences; 0 = all (default 100).");
+  cmd->add_option("--template", args->template_obj,
+                  "OBJ with the mesh topology and UVs (default: the neutral frame's tracked_mesh OBJ).");
+  cmd->add_option("--matte", args->matte, "mesh (the mesh silhouette, dilated and feathered) or none (opaque).")
+      ->check(CLI::IsMember({"mesh", "none"}));
+  cmd->add_option("--downsample", args->downsample, "Image size divisor: 1 = full size (default), 2 = half.");
+  cmd->add_option("--threads", args->threads, "Worker threads (default: one per hardware thread).");
+  cmd->add_flag("--force", args->force, "Replace --out if it already exists.");
+  cmd->add_flag("--print-options", args->print_options, "Print every ingest option with its default and exit.");
+
+  cmd->callback([args] {
+    ingest::IngestOptions options;
+    if (!args->config.empty()) load_options(options, args->config, "ingest");
+    for (const auto& kv : args->overrides) {
+      const auto eq = kv.find('=');
+      if (eq == std::string::npos) throw Error("--set " + kv + ": expected key=value");
+      set_option(options, kv.substr(0, eq), kv.substr(eq + 1));
+    }
+    if (!args->cameras.empty()) options.cameras = args->cameras;
+    if (!args->test_cameras.empty()) options.test_cameras = args->test_cameras;
+    if (!args->expressions.empty()) options.expressions = args->expressions;
+    if (!args->test_expressions.empty()) options.test_expressions = args->test_expressions;
+    if (args->frames) options.frames = *args->frames;
+    if (args->test_frames) options.test_frames = *args->test_frames;
+    if (!args->template_obj.empty()) options.template_obj = args->template_obj;
+    if (!args->matte.empty()) options.matte = args->matte;
+    if (args->downsample) options.downsample = *args->downsample;
+    if (args->threads) options.threads = *args->threads;
+    if (args->print_options) {
+      std::cout << "ingest:\n";
+      std::istringstream yaml(options_to_yaml(options));
+      for (std::string line; std::getline(yaml, line);) std::cout << "  " << line << "\n";
+      return;
+    }
+    if (args->capture.empty() || args->out.empty()) throw Error("tega ingest multiface needs --capture and --out");
+    const auto s = ingest::ingest_multiface(args->capture, args->out, options, args->force);
+    std::cout << s.dataset.string() << ": " << s.train_frames << " train + " << s.test_frames << " test frames, "
+              << s.images << " images; train cameras: " << joined(s.train_cameras)
+              << "; test cameras: " << joined(s.test_cameras) << "\n";
+  });
+}
+
+}  // namespace tega::cli
