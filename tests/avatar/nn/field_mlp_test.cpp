@@ -78,7 +78,11 @@ TEST(FieldMLP, TangentJacobianMatchesAutogradAndFiniteDifferences) {
     at::Tensor step = at::zeros({1, 3}, at::kDouble);
     step[0][axis] = h;
     const at::Tensor fd = (mlp->forward(uvd + step, condition) - mlp->forward(uvd - step, condition)) / (2 * h);
-    EXPECT_TRUE(at::allclose(out.jacobian.select(2, axis), fd, 1e-6, 1e-8)) << "axis " << axis;
+    // Loose: the d axis carries frequencies up to 2^5·π·3 per metre, so the
+    // truncation error of the difference quotient is ~1e-6 relative; the
+    // autograd comparison above is the tight one.
+    EXPECT_TRUE(at::allclose(out.jacobian.select(2, axis), fd, 1e-4, 1e-7))
+        << "axis " << axis << ", max error " << (out.jacobian.select(2, axis) - fd).abs().max().item<double>();
   }
 }
 
