@@ -8,5 +8,6 @@ namespace tega::cli {
 void add_synth_command(CLI::App& app);
 void add_dataset_command(CLI::App& app);
 void add_rig_command(CLI::App& app);
+void add_ingest_command(CLI::App& app);
 void add_train_command(CLI::App& app);
 }  // namespace tega::cli

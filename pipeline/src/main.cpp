@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
 
   tega::cli::add_dataset_command(app);
   tega::cli::add_rig_command(app);
+  tega::cli::add_ingest_command(app);
 #ifdef TEGA_HAVE_SYNTH
   tega::cli::add_synth_command(app);
 #endif

@@ -162,7 +162,8 @@ class Run {
     summary.heldout_psnr = heldout_psnr();
     summary.checkpoint = run_dir_ / kCheckpoint;
     if (profiler_.enabled()) {
-      for (const auto& [name, ms] : profiler_.mean_milliseconds(iteration_ - first)) {
+      summary.milliseconds_per_step = profiler_.mean_milliseconds(iteration_ - first);
+      for (const auto& [name, ms] : summary.milliseconds_per_step) {
         spdlog::info("profile: {:>14} {:8.2f} ms/it", name, ms);
       }
     }
@@ -207,7 +208,7 @@ class Run {
     profiler_.section("losses");
     const at::Tensor rendered = raster.rgb[0].permute({2, 0, 1});
     const at::Tensor target = composite_target(loaded.rgba.to(device_), background_);
-    at::Tensor loss = options_.loss.l1 * (rendered - target).abs().mean() +
+    at::Tensor loss = options_.loss.l1 * nn::l1_image_loss(rendered, target) +
                       options_.loss.dssim * nn::dssim_loss(rendered, target);
     const double vgg_weight = schedules::vgg_weight(options_.loss, iteration_, options_.iterations);
     if (vgg_ && vgg_weight > 0) loss = loss + vgg_weight * (*vgg_)(rendered.unsqueeze(0), target.unsqueeze(0));

@@ -8,6 +8,7 @@
 //   RUN/run.json                     dataset, state and the final summary
 
 #include <filesystem>
+#include <map>
 #include <string>
 
 #include "tega/trainer/options.h"
@@ -22,6 +23,7 @@ struct TrainSummary {
   double train_psnr = 0;        // mean over the last logged window
   double heldout_psnr = 0;      // train frames seen from the test cameras (novel view)
   std::filesystem::path checkpoint;
+  std::map<std::string, double> milliseconds_per_step;  // by part of the step, with options.profile
 };
 
 struct RunControl {
