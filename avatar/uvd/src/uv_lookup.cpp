@@ -50,14 +50,30 @@ std::tuple<at::Tensor, at::Tensor, at::Tensor> UvTriangleLookup::closest_points(
           at::where(inside.unsqueeze(1), uv, point), at::where(inside.unsqueeze(1), b, point_b)};
 }
 
+UvTriangleLookup::Nearest UvTriangleLookup::nearest_candidate(const at::Tensor& uv, const at::Tensor& start,
+                                                               const at::Tensor& count) const {
+  // One row per (query, candidate); keep the first closest candidate of each query.
+  const int64_t n = uv.size(0);
+  const auto long_options = start.options();
+  const auto owner = at::repeat_interleave(at::arange(n, long_options), count);
+  const int64_t pairs = owner.size(0);
+  const auto pair_index = at::arange(pairs, long_options);
+  const auto rank = pair_index - (count.cumsum(0) - count).index_select(0, owner);
+  const auto candidate = cell_triangles_.index_select(0, start.index_select(0, owner) + rank).to(at::kLong);
+  const auto [d2, q, b] = closest_points(uv.index_select(0, owner), candidate);
+  const auto best = at::full({n}, INFINITY, d2.options()).scatter_reduce(0, owner, d2, "amin");
+  const auto key = at::where(d2 <= best.index_select(0, owner), pair_index, at::full_like(pair_index, pairs));
+  const auto chosen = at::full({n}, pairs, long_options).scatter_reduce(0, owner, key, "amin");
+  return {candidate.index_select(0, chosen), d2.index_select(0, chosen), q.index_select(0, chosen),
+          b.index_select(0, chosen)};
+}
+
 UvHit UvTriangleLookup::lookup(const at::Tensor& uv_in) const {
   TORCH_CHECK(uv_in.dim() == 2 && uv_in.size(1) == 2, "uv lookup: uv must be [N,2]");
   TORCH_CHECK(uv_in.device() == device(), "uv lookup: uv is on ", uv_in.device(), ", the lookup on ", device());
   const auto uv = uv_in.detach();
   const int64_t n = uv.size(0);
-  const auto long_options = uv.options().dtype(at::kLong);
-  if (n == 0)
-    return {at::empty({0}, long_options), uv.new_empty({0, 3}), uv.clone(), uv.new_empty({0})};
+  if (n == 0) return {at::empty({0}, uv.options().dtype(at::kLong)), uv.new_empty({0, 3}), uv.clone(), uv.new_empty({0})};
   auto texel = [&](int axis) {
     return ((uv.select(1, axis) - origin_[axis]) / texel_[axis]).floor().clamp(0, cells_[axis] - 1).to(at::kLong);
   };
@@ -65,27 +81,21 @@ UvHit UvTriangleLookup::lookup(const at::Tensor& uv_in) const {
   const auto start = cell_offsets_.index_select(0, cell).to(at::kLong);
   const auto count = cell_offsets_.index_select(0, cell + 1).to(at::kLong) - start;
 
-  at::Tensor triangle, distance2, point, barycentrics;
-  if (count.max().item<int64_t>() == 1) {
-    triangle = cell_triangles_.index_select(0, start).to(at::kLong);
-    std::tie(distance2, point, barycentrics) = closest_points(uv, triangle);
-  } else {
-    // One row per (query, candidate); keep the first closest candidate of each query.
-    const auto owner = at::repeat_interleave(at::arange(n, long_options), count);
-    const int64_t pairs = owner.size(0);
-    const auto pair_index = at::arange(pairs, long_options);
-    const auto rank = pair_index - (count.cumsum(0) - count).index_select(0, owner);
-    const auto candidate = cell_triangles_.index_select(0, start.index_select(0, owner) + rank).to(at::kLong);
-    const auto [d2, q, b] = closest_points(uv.index_select(0, owner), candidate);
-    const auto best = at::full({n}, INFINITY, d2.options()).scatter_reduce(0, owner, d2, "amin");
-    const auto key = at::where(d2 <= best.index_select(0, owner), pair_index, at::full_like(pair_index, pairs));
-    const auto chosen = at::full({n}, pairs, long_options).scatter_reduce(0, owner, key, "amin");
-    triangle = candidate.index_select(0, chosen);
-    distance2 = d2.index_select(0, chosen);
-    point = q.index_select(0, chosen);
-    barycentrics = b.index_select(0, chosen);
+  // A texel's first candidate contains its centre (where one does), so most
+  // valid queries are settled by it; the rest try all their candidates.
+  Nearest found;
+  found.triangle = cell_triangles_.index_select(0, start).to(at::kLong);
+  std::tie(found.distance2, found.point, found.barycentrics) = closest_points(uv, found.triangle);
+  const auto unsettled = ((found.distance2 > 0) & (count > 1)).nonzero().view({-1});
+  if (unsettled.size(0) > 0) {
+    const Nearest rest =
+        nearest_candidate(uv.index_select(0, unsettled), start.index_select(0, unsettled), count.index_select(0, unsettled));
+    found.triangle.index_copy_(0, unsettled, rest.triangle);
+    found.distance2.index_copy_(0, unsettled, rest.distance2);
+    found.point.index_copy_(0, unsettled, rest.point);
+    found.barycentrics.index_copy_(0, unsettled, rest.barycentrics);
   }
-  return {triangle, barycentrics, point, distance2.sqrt()};
+  return {found.triangle, found.barycentrics, found.point, found.distance2.sqrt()};
 }
 
 at::Tensor UvTriangleLookup::project_to_valid_uv(const at::Tensor& uv) const { return lookup(uv).uv; }

@@ -256,6 +256,15 @@ void LookupBuilder::build(UvTriangleLookup& lookup, const Mesh& mesh, const UvLo
   auto* tri = triangles.data_ptr<int32_t>();
   std::vector<int32_t> fill(off, off + num_cells);
   for (const auto& [cell, t] : pairs) tri[fill[cell]++] = t;
+  // The triangle containing the texel's centre goes first: the query tries it alone first.
+  for (int64_t c = 0; c < num_cells; ++c) {
+    const Vec2 centre{grid.ox + (c % nx + 0.5) * grid.tx, grid.oy + (c / nx + 0.5) * grid.ty};
+    for (int32_t k = off[c]; k < off[c + 1]; ++k)
+      if (contains(tris[tri[k]], centre)) {
+        std::swap(tri[off[c]], tri[k]);
+        break;
+      }
+  }
 
   lookup.cells_[0] = nx;
   lookup.cells_[1] = ny;

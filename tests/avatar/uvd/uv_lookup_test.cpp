@@ -85,7 +85,7 @@ void expect_nearest_points(const Mesh& mesh, const UvTriangleLookup& lookup, int
 
 TEST(UvLookup, InsidePointsFindTheirTriangleAtAnyResolution) {
   const Mesh mesh = seamed_mesh();
-  for (int resolution : {1, 7, 64, 512}) {
+  for (double resolution : {1.0, 7.0, 64.0, 512.0}) {
     SCOPED_TRACE(resolution);
     expect_inside_points_found(mesh, UvTriangleLookup(mesh, {resolution, 0.1}), valid_faces(mesh), 20);
   }
@@ -93,7 +93,7 @@ TEST(UvLookup, InsidePointsFindTheirTriangleAtAnyResolution) {
 
 TEST(UvLookup, OutsidePointsGoToTheNearestTriangleAtAnyResolution) {
   const Mesh mesh = seamed_mesh();
-  for (int resolution : {1, 5, 40, 300}) {
+  for (double resolution : {1.0, 5.0, 40.0, 300.0}) {
     SCOPED_TRACE(resolution);
     expect_nearest_points(mesh, UvTriangleLookup(mesh, {resolution, 0.1}), 3000, 1e-12, at::kDouble);
   }

@@ -95,6 +95,12 @@ class UvTriangleLookup {
   // Closest points of uv [P,2] on triangles [P]: squared distance [P], point [P,2], its barycentrics [P,3].
   std::tuple<at::Tensor, at::Tensor, at::Tensor> closest_points(const at::Tensor& uv, const at::Tensor& triangle) const;
 
+  struct Nearest {
+    at::Tensor triangle, distance2, point, barycentrics;
+  };
+  // The closest of the candidates [start, start+count) of every query.
+  Nearest nearest_candidate(const at::Tensor& uv, const at::Tensor& start, const at::Tensor& count) const;
+
   int cells_[2] = {0, 0};     // texels along u and v
   double origin_[2] = {0, 0};  // uv of the grid's lower-left corner
   double texel_[2] = {1, 1};   // texel size in u and v
