@@ -29,6 +29,8 @@ int main(int argc, char** argv) {
 #ifdef TEGA_HAVE_TRAINER
   tega::cli::add_train_command(app);
 #endif
+  tega::cli::add_run_command(app);
+  tega::cli::add_status_command(app);
 
   try {
     app.parse(argc, argv);

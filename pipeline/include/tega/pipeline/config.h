@@ -1,0 +1,48 @@
+#pragma once
+// A pipeline config (docs/pipeline.md#configs): the workspace, the subjects
+// and the stages in graph order, each with its options. Loading is strict: an
+// unknown key is an error naming the file, the key and the known keys.
+// Relative paths in a config resolve against the config file's directory, so
+// a config means the same thing from wherever it is run.
+
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace tega::pipeline {
+
+struct StageConfig {
+  std::string name;                // the key under `stages`
+  std::string kind;                // `kind`, default: the name (docs/pipeline.md#stage-kinds)
+  std::vector<std::string> after;  // upstream stages
+  std::string options_yaml;        // `options_file` with `options` merged over it; canonical YAML, "" = none
+};
+
+struct SubjectConfig {
+  std::string name;
+  std::filesystem::path capture;                     // absolute; empty = none
+  std::map<std::string, std::string> stage_options;  // stage -> canonical YAML merged over its options
+};
+
+struct PipelineConfig {
+  std::filesystem::path source;    // the file, named in errors
+  std::filesystem::path base_dir;  // where relative paths resolve (absolute)
+  std::string text;                // the file as read (recorded in the workspace for `tega status`)
+  std::filesystem::path workspace;
+  std::vector<SubjectConfig> subjects;  // never empty: one subject "default" when the config has none
+  std::vector<StageConfig> stages;      // in file order
+
+  // The options of `stage` for `subject`: the stage's, with the subject's overlay merged in.
+  std::string options_for(const StageConfig& stage, const SubjectConfig& subject) const;
+};
+
+PipelineConfig load_pipeline_config(const std::filesystem::path& file);  // throws tega::Error naming the file
+PipelineConfig parse_pipeline_config(const std::string& text, const std::filesystem::path& source,
+                                     const std::filesystem::path& base_dir);
+
+// The value of a scalar option (dotted key: "loss.vgg_weights") in options YAML, if set.
+std::optional<std::string> scalar_option(const std::string& options_yaml, const std::string& dotted_key);
+
+}  // namespace tega::pipeline

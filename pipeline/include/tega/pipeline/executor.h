@@ -1,0 +1,54 @@
+#pragma once
+// Executors run shard commands; the orchestrator decides what runs and
+// commits the results. A job is a command line, a log file and the resources
+// it needs, so a cluster executor (Slurm: one sbatch per job, polled through
+// sacct) can run the very same jobs without any stage changing.
+
+#include <chrono>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace tega::pipeline {
+
+struct Resources {
+  // "" for a CPU job; else the GPU device it uses ("cuda", "cuda:1"), which
+  // runs one job at a time.
+  std::string gpu_device;
+};
+
+struct Job {
+  std::string id;                  // "<stage>/<shard>", unique among an executor's jobs
+  std::vector<std::string> argv;   // argv[0] is the program
+  std::filesystem::path working_directory;
+  std::filesystem::path log_file;  // stdout and stderr, appended
+  Resources resources;
+};
+
+struct JobResult {
+  std::string id;
+  bool succeeded = false;
+  std::string failure;  // "exit code 1", "killed by signal 9", "could not start: ..."
+  double seconds = 0;
+};
+
+class Executor {
+ public:
+  virtual ~Executor() = default;
+
+  // Queues a job; it starts when its resources are free. Never blocks.
+  virtual void submit(Job job) = 0;
+
+  // Waits at most `timeout` for jobs to finish and returns those that did
+  // (possibly none), each exactly once.
+  virtual std::vector<JobResult> wait(std::chrono::milliseconds timeout) = 0;
+
+  // Drops queued jobs and stops running ones; returns when none runs any more.
+  // Their results are not reported.
+  virtual void cancel_all() = 0;
+
+  virtual std::vector<std::string> running() const = 0;  // ids of the jobs running now
+  virtual size_t unfinished() const = 0;                  // queued or running
+};
+
+}  // namespace tega::pipeline

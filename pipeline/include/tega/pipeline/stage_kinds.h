@@ -1,0 +1,42 @@
+#pragma once
+// What a stage of each kind does: the `tega` subcommand a shard runs, the
+// artifacts it needs from upstream stages and the ones it provides, and the
+// external inputs it reads (docs/pipeline.md#stage-kinds). Adding a stage is
+// adding a kind here; neither the orchestrator nor the executors change.
+
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace tega::pipeline {
+
+// Where one shard's command reads and writes; every path is absolute.
+struct ShardPaths {
+  std::filesystem::path output;        // the shard's staging directory: outputs go under it
+  std::filesystem::path options_file;  // the stage's options as a YAML file; empty for kinds without options
+  std::map<std::string, std::filesystem::path> artifacts;  // each needed artifact -> its path
+  std::filesystem::path capture;       // the subject's capture directory (kinds that read one)
+};
+
+struct StageKind {
+  std::string name;
+  std::string summary;
+  // The `tega` subcommand a shard runs, e.g. {"dataset", "check"}. Empty:
+  // the stage is not implemented in tega yet and is reported as such.
+  std::vector<std::string> subcommand;
+  std::vector<std::string> needs;                        // artifacts taken from upstream stages
+  std::map<std::string, std::string> provides;           // artifact -> path inside the shard directory
+  bool takes_options = true;                             // options are passed as --config FILE
+  bool reads_capture = false;                            // the subject's `capture` is an input
+  std::vector<std::string> path_options;                 // options that name external input files
+  std::string device_option;                             // option naming the device ("cuda..." = a GPU stage)
+  std::function<std::vector<std::string>(const ShardPaths&)> arguments;  // after the subcommand
+};
+
+const std::vector<StageKind>& stage_kinds();
+const StageKind* find_stage_kind(std::string_view name);  // nullptr when unknown
+
+}  // namespace tega::pipeline

@@ -1,0 +1,161 @@
+#include "tega/pipeline/local_executor.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstring>
+#include <string>
+#include <thread>
+
+#include "tega/core/error.h"
+#include "tega/pipeline/manifest.h"
+
+namespace tega::pipeline {
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+constexpr auto kPollInterval = std::chrono::milliseconds(20);
+
+std::string describe_exit(int status) {
+  if (WIFEXITED(status)) return "exit code " + std::to_string(WEXITSTATUS(status));
+  if (WIFSIGNALED(status)) return std::string("killed by signal ") + std::to_string(WTERMSIG(status)) + " (" +
+                                  strsignal(WTERMSIG(status)) + ")";
+  return "ended with wait status " + std::to_string(status);
+}
+
+// Between fork and exec only async-signal-safe calls are allowed.
+[[noreturn]] void exec_child(pid_t parent, int log_fd, const char* directory, char* const* argv) {
+  ::setpgid(0, 0);  // its own group: a terminal's Ctrl-C reaches the orchestrator, which stops the jobs
+  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (::getppid() != parent) ::_exit(125);  // the orchestrator died before prctl took effect
+  sigset_t none;
+  sigemptyset(&none);
+  ::sigprocmask(SIG_SETMASK, &none, nullptr);
+  const int null_fd = ::open("/dev/null", O_RDONLY);
+  if (null_fd >= 0) ::dup2(null_fd, STDIN_FILENO);
+  ::dup2(log_fd, STDOUT_FILENO);
+  ::dup2(log_fd, STDERR_FILENO);
+  if (::chdir(directory) != 0) {
+    const char message[] = "tega run: cannot enter the working directory\n";
+    (void)!::write(STDERR_FILENO, message, sizeof message - 1);
+    ::_exit(126);
+  }
+  ::execv(argv[0], argv);
+  const char message[] = "tega run: cannot execute the shard's command\n";
+  (void)!::write(STDERR_FILENO, message, sizeof message - 1);
+  ::_exit(127);
+}
+
+}  // namespace
+
+LocalExecutor::LocalExecutor(int cpu_slots, std::chrono::milliseconds stop_grace)
+    : cpu_slots_(std::max(1, cpu_slots)), stop_grace_(stop_grace) {}
+
+LocalExecutor::~LocalExecutor() { cancel_all(); }
+
+void LocalExecutor::submit(Job job) { queue_.push_back(std::move(job)); }
+
+pid_t LocalExecutor::launch(const Job& job) {
+  fs::create_directories(job.log_file.parent_path());
+  const int log_fd = ::open(job.log_file.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  if (log_fd < 0) throw Error(job.log_file, "cannot be opened for writing");
+  std::string header = "=== " + utc_now() + " " + job.id + ":";
+  for (const auto& a : job.argv) header += " " + a;
+  header += "\n";
+  (void)!::write(log_fd, header.data(), header.size());
+
+  std::vector<char*> argv;
+  for (const auto& a : job.argv) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  const std::string directory = job.working_directory.string();
+  const pid_t parent = ::getpid();
+  const pid_t pid = ::fork();
+  if (pid == 0) exec_child(parent, log_fd, directory.c_str(), argv.data());
+  ::close(log_fd);
+  if (pid < 0) throw Error(std::string("cannot start ") + job.id + ": fork failed: " + std::strerror(errno));
+  ::setpgid(pid, pid);  // also here, so that the group exists before any kill(-pid)
+  return pid;
+}
+
+void LocalExecutor::start_ready_jobs(std::vector<JobResult>& results) {
+  int cpu_running = 0;
+  for (const auto& [pid, r] : running_) cpu_running += r.job.resources.gpu_device.empty() ? 1 : 0;
+  for (auto it = queue_.begin(); it != queue_.end();) {
+    const std::string& device = it->resources.gpu_device;
+    bool free = false;
+    if (device.empty()) {
+      free = cpu_running < cpu_slots_;
+    } else {
+      free = true;
+      for (const auto& [pid, r] : running_) free = free && r.job.resources.gpu_device != device;
+    }
+    if (!free) {
+      ++it;
+      continue;
+    }
+    try {
+      const pid_t pid = launch(*it);
+      running_[pid] = {std::move(*it), Clock::now()};
+      cpu_running += device.empty() ? 1 : 0;
+    } catch (const std::exception& e) {
+      results.push_back({it->id, false, std::string("could not start: ") + e.what(), 0});
+    }
+    it = queue_.erase(it);
+  }
+}
+
+bool LocalExecutor::reap(std::vector<JobResult>& results, bool block) {
+  bool any = false;
+  for (auto it = running_.begin(); it != running_.end();) {
+    int status = 0;
+    const pid_t done = ::waitpid(it->first, &status, block ? 0 : WNOHANG);
+    if (done == it->first || (done < 0 && errno == ECHILD)) {
+      const double seconds = std::chrono::duration<double>(Clock::now() - it->second.started).count();
+      const bool ok = done == it->first && WIFEXITED(status) && WEXITSTATUS(status) == 0;
+      results.push_back({it->second.job.id, ok, ok ? "" : done < 0 ? "lost track of the process" : describe_exit(status),
+                         seconds});
+      it = running_.erase(it);
+      any = true;
+    } else {
+      ++it;
+    }
+  }
+  return any;
+}
+
+std::vector<JobResult> LocalExecutor::wait(std::chrono::milliseconds timeout) {
+  std::vector<JobResult> results;
+  const auto deadline = Clock::now() + timeout;
+  start_ready_jobs(results);
+  while (results.empty() && Clock::now() < deadline && !running_.empty()) {
+    std::this_thread::sleep_for(kPollInterval);
+    if (reap(results, false)) start_ready_jobs(results);
+  }
+  return results;
+}
+
+void LocalExecutor::cancel_all() {
+  queue_.clear();
+  for (const auto& [pid, r] : running_) ::kill(-pid, SIGTERM);
+  const auto deadline = Clock::now() + stop_grace_;
+  std::vector<JobResult> ignored;
+  while (!running_.empty() && Clock::now() < deadline) {
+    reap(ignored, false);
+    if (!running_.empty()) std::this_thread::sleep_for(kPollInterval);
+  }
+  for (const auto& [pid, r] : running_) ::kill(-pid, SIGKILL);
+  reap(ignored, true);
+}
+
+std::vector<std::string> LocalExecutor::running() const {
+  std::vector<std::string> ids;
+  for (const auto& [pid, r] : running_) ids.push_back(r.job.id);
+  return ids;
+}
+
+}  // namespace tega::pipeline

@@ -1,0 +1,126 @@
+#include "tega/pipeline/stage_kinds.h"
+
+namespace tega::pipeline {
+namespace {
+
+std::vector<std::string> with_config(std::vector<std::string> arguments, const ShardPaths& p) {
+  arguments.insert(arguments.end(), {"--config", p.options_file.string()});
+  return arguments;
+}
+
+// A stage of the capture chain that tega does not implement yet: declared so
+// that capture-based configs describe their whole graph and report it honestly.
+StageKind not_implemented(std::string name, std::string summary, std::vector<std::string> needs,
+                          std::map<std::string, std::string> provides) {
+  StageKind kind;
+  kind.name = std::move(name);
+  kind.summary = std::move(summary);
+  kind.needs = std::move(needs);
+  kind.provides = std::move(provides);
+  return kind;
+}
+
+std::vector<StageKind> make_stage_kinds() {
+  std::vector<StageKind> kinds;
+
+  StageKind synth;
+  synth.name = "synth";
+  synth.summary = "virtual studio: a synthetic capture with ground truth and a ready dataset (tega synth)";
+  synth.subcommand = {"synth"};
+  synth.provides = {{"capture", "capture"}, {"dataset", "capture/dataset"}};
+  synth.path_options = {"head"};
+  synth.arguments = [](const ShardPaths& p) { return with_config({"--out", (p.output / "capture").string()}, p); };
+  kinds.push_back(synth);
+
+  StageKind ingest;
+  ingest.name = "ingest_multiface";
+  ingest.summary = "a Multiface capture converted to a dataset (tega ingest multiface)";
+  ingest.subcommand = {"ingest", "multiface"};
+  ingest.provides = {{"dataset", "dataset"}};
+  ingest.reads_capture = true;
+  ingest.arguments = [](const ShardPaths& p) {
+    return with_config({"--capture", p.capture.string(), "--out", (p.output / "dataset").string()}, p);
+  };
+  kinds.push_back(ingest);
+
+  StageKind check;
+  check.name = "dataset_check";
+  check.summary = "checks a dataset the way training does (tega dataset check)";
+  check.subcommand = {"dataset", "check"};
+  check.needs = {"dataset"};
+  check.takes_options = false;
+  check.arguments = [](const ShardPaths& p) {
+    return std::vector<std::string>{"--data", p.artifacts.at("dataset").string()};
+  };
+  kinds.push_back(check);
+
+  StageKind train;
+  train.name = "train";
+  train.summary = "trains a TeGA avatar (tega train)";
+  train.subcommand = {"train"};
+  train.needs = {"dataset"};
+  train.provides = {{"run", "run"}};
+  train.path_options = {"loss.vgg_weights"};
+  train.device_option = "device";
+  train.arguments = [](const ShardPaths& p) {
+    return with_config({"--data", p.artifacts.at("dataset").string(), "--out", (p.output / "run").string()}, p);
+  };
+  kinds.push_back(train);
+
+  // eval and render plug in once their commands exist (issue 5); until then
+  // the running binary lacks the subcommand and the stage reports itself unavailable.
+  StageKind eval;
+  eval.name = "eval";
+  eval.summary = "evaluates a trained avatar on the dataset's test split: the eval table (tega eval)";
+  eval.subcommand = {"eval"};
+  eval.needs = {"run", "dataset"};
+  eval.provides = {{"eval", "eval"}};
+  eval.device_option = "device";
+  eval.arguments = [](const ShardPaths& p) {
+    return with_config({"--run", p.artifacts.at("run").string(), "--data", p.artifacts.at("dataset").string(),
+                        "--out", (p.output / "eval").string()},
+                       p);
+  };
+  kinds.push_back(eval);
+
+  StageKind render;
+  render.name = "render";
+  render.summary = "renders a trained avatar from the dataset's cameras (tega render)";
+  render.subcommand = {"render"};
+  render.needs = {"run", "dataset"};
+  render.provides = {{"renders", "renders"}};
+  render.device_option = "device";
+  render.arguments = [](const ShardPaths& p) {
+    return with_config({"--run", p.artifacts.at("run").string(), "--data", p.artifacts.at("dataset").string(),
+                        "--out", (p.output / "renders").string()},
+                       p);
+  };
+  kinds.push_back(render);
+
+  kinds.push_back(not_implemented("capture", "records takes from the GenICam rig (Aravis)", {}, {{"capture", "capture"}}));
+  kinds.push_back(not_implemented("calibrate", "calibrates the rig from the ChArUco take (OpenCV + Ceres)",
+                                  {"capture"}, {{"rig", "rig.json"}}));
+  kinds.push_back(not_implemented("mvs", "reconstructs a mesh per frame (multi-view stereo)", {"capture", "rig"},
+                                  {{"meshes", "meshes"}}));
+  kinds.push_back(not_implemented("tracking", "fits the blendshape template to the per-frame meshes",
+                                  {"meshes", "rig"}, {{"tracked", "tracked"}}));
+  kinds.push_back(not_implemented("matting", "mattes and downsamples the images into a dataset",
+                                  {"capture", "rig", "tracked"}, {{"dataset", "dataset"}}));
+  return kinds;
+}
+
+}  // namespace
+
+const std::vector<StageKind>& stage_kinds() {
+  static const std::vector<StageKind> kinds = make_stage_kinds();
+  return kinds;
+}
+
+const StageKind* find_stage_kind(std::string_view name) {
+  for (const auto& kind : stage_kinds()) {
+    if (kind.name == name) return &kind;
+  }
+  return nullptr;
+}
+
+}  // namespace tega::pipeline

@@ -1,0 +1,95 @@
+// `tega run CONFIG`: runs a pipeline config's stage graph (docs/pipeline.md).
+
+#include <signal.h>
+
+#include <atomic>
+#include <iostream>
+#include <memory>
+#include <thread>
+
+#include "available_commands.h"
+#include "commands.h"
+#include "tega/pipeline/local_executor.h"
+#include "tega/pipeline/orchestrator.h"
+
+namespace tega::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::atomic<bool> stop_requested{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "set from a signal handler");
+
+void request_stop(int) { stop_requested = true; }
+
+// SIGINT and SIGTERM ask the run to stop: no new shards, running ones are
+// terminated, and the next run picks up from the committed shards.
+class StopOnSignals {
+ public:
+  StopOnSignals() {
+    struct sigaction action {};
+    action.sa_handler = request_stop;
+    sigemptyset(&action.sa_mask);
+    ::sigaction(SIGINT, &action, &previous_int_);
+    ::sigaction(SIGTERM, &action, &previous_term_);
+  }
+  ~StopOnSignals() {
+    ::sigaction(SIGINT, &previous_int_, nullptr);
+    ::sigaction(SIGTERM, &previous_term_, nullptr);
+  }
+
+ private:
+  struct sigaction previous_int_ {}, previous_term_ {};
+};
+
+struct RunArguments {
+  std::string config, workspace;
+  std::vector<std::string> only, from, force;
+  int jobs = 0;
+};
+
+void run(const RunArguments& args, const CLI::App& root) {
+  pipeline::PipelineConfig config = pipeline::load_pipeline_config(args.config);
+  if (!args.workspace.empty()) config.workspace = fs::absolute(args.workspace).lexically_normal();
+  const pipeline::StageGraph graph(std::move(config),
+                                   [&](const std::vector<std::string>& path) { return has_subcommand(root, path); });
+
+  pipeline::RunRequest request;
+  request.only = args.only;
+  request.from = args.from;
+  request.force = args.force;
+  request.tega_executable = fs::read_symlink("/proc/self/exe");
+  request.tool_version = std::string("tega ") + TEGA_VERSION;
+
+  const int jobs = args.jobs > 0 ? args.jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  pipeline::LocalExecutor executor(jobs);
+  const StopOnSignals stop_on_signals;
+  const pipeline::RunSummary summary = pipeline::run_pipeline(graph, request, executor, stop_requested);
+
+  for (const auto& problem : summary.problems) std::cerr << "tega run: " << problem << "\n";
+  std::cout << "tega run: " << summary.ran << " shard(s) ran, " << summary.up_to_date << " up to date, "
+            << summary.failed << " failed, " << summary.blocked << " blocked, " << summary.unavailable
+            << " unavailable; workspace " << graph.config().workspace.string() << "\n";
+  if (summary.interrupted) std::cerr << "tega run: interrupted; run it again to continue from the committed shards\n";
+  if (summary.exit_code() != 0) throw CLI::RuntimeError(summary.exit_code());
+}
+
+}  // namespace
+
+void add_run_command(CLI::App& app) {
+  auto args = std::make_shared<RunArguments>();
+  auto* cmd = app.add_subcommand(
+      "run", "Run a pipeline config's stages (docs/pipeline.md): shards whose manifest matches are skipped, so an "
+             "interrupted or failed run continues where it stopped.");
+  cmd->add_option("config", args->config, "Pipeline config (YAML), e.g. studio_configs/demo.yaml.")->required();
+  cmd->add_option("--only", args->only, "Run just this stage (repeatable); the stages it needs must be done.");
+  cmd->add_option("--from", args->from, "Re-run this stage and every stage downstream of it (repeatable).");
+  cmd->add_option("--force", args->force, "Re-run this stage even where it is done (repeatable).");
+  cmd->add_option("--jobs", args->jobs, "CPU shards run in parallel (default: one per hardware thread); "
+                                        "GPU shards run one at a time per device.");
+  cmd->add_option("--workspace", args->workspace, "Use this workspace instead of the config's.");
+  const CLI::App* root = &app;
+  cmd->callback([args, root] { run(*args, *root); });
+}
+
+}  // namespace tega::cli
