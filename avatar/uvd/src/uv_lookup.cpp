@@ -112,7 +112,7 @@ at::Tensor UvTriangleLookup::sample_uniform(int64_t n, uint64_t seed) const {
   return (b.unsqueeze(-1) * corners).sum(1).to(at::kFloat).to(device());
 }
 
-UvTriangleLookup::Tables UvTriangleLookup::tables_to(const Tables& t, const at::Device& device) const {
+UvTriangleLookup::Tables UvTriangleLookup::tables_to(const Tables& t, const at::Device& device) {
   return {t.corners.to(device), t.inverse.to(device), t.gradient.to(device)};
 }
 

@@ -2,8 +2,9 @@
 // uv -> triangle lookup on a template's UV layout (docs/uvd-rigging.md).
 //
 // Built once per template on the CPU: a texel grid over the UV bounding box of
-// the active triangles (grown by a margin) where every texel lists the candidate triangles that can
-// contain, or be nearest to, any point of the texel. A query is one texel
+// the active triangles (grown by a margin) where every texel lists the
+// candidate triangles that can contain, or be nearest to, any point of the
+// texel. A query is one texel
 // fetch plus an exact point-in-triangle / closest-point test against the
 // texel's candidates, so the answer is exact (not limited by the resolution):
 //  - a uv inside a triangle returns that triangle and its barycentrics
@@ -12,7 +13,8 @@
 //    returns the closest point of the nearest triangle.
 // Queries are tensor ops, so they run on the device of the lookup's tensors
 // (move it with to()). Exactness holds inside the grid's domain; a uv beyond
-// it is first clamped into the domain (it is meaningless for training anyway).
+// it is answered from the nearest border texel's candidates, so it lands on a
+// triangle, not necessarily the nearest (such a uv means nothing anyway).
 // Only active triangles are returned; zero-area UV triangles never are.
 // UV islands must not overlap among the active triangles (ICT-FaceKit's eyes,
 // eye blend and occlusion meshes share the face's UV tile, so activate the
@@ -84,14 +86,13 @@ class UvTriangleLookup {
   const at::Tensor& barycentric_gradient(at::ScalarType dtype) const;
 
  private:
-  UvTriangleLookup() = default;
   struct Tables {
     at::Tensor corners;   // [F,3,2] uv of the corners
     at::Tensor inverse;   // [F,2,2] (u,v) - corner0 -> (b1,b2)
     at::Tensor gradient;  // [F,3,2] ∂b/∂(u,v)
   };
   const Tables& tables(at::ScalarType dtype) const;
-  Tables tables_to(const Tables& t, const at::Device& device) const;
+  static Tables tables_to(const Tables& t, const at::Device& device);
   // Closest points of uv [P,2] on triangles [P]: squared distance [P], point [P,2], its barycentrics [P,3].
   std::tuple<at::Tensor, at::Tensor, at::Tensor> closest_points(const at::Tensor& uv, const at::Tensor& triangle) const;
 
@@ -101,7 +102,7 @@ class UvTriangleLookup {
   // The closest of the candidates [start, start+count) of every query.
   Nearest nearest_candidate(const at::Tensor& uv, const at::Tensor& start, const at::Tensor& count) const;
 
-  int cells_[2] = {0, 0};     // texels along u and v
+  int cells_[2] = {0, 0};      // texels along u and v
   double origin_[2] = {0, 0};  // uv of the grid's lower-left corner
   double texel_[2] = {1, 1};   // texel size in u and v
   at::Tensor cell_offsets_;    // [cells+1] int32 into cell_triangles_; texel (i,j) is cell j*cells_[0]+i
