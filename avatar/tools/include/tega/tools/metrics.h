@@ -1,0 +1,40 @@
+#pragma once
+// Image metrics of `tega eval` (TeGA §5), on float RGB images [3,H,W] in [0,1]:
+// over the full image, and inside a mask (the dataset's matte, alpha > 0.5).
+//
+//  - PSNR = 10 log10(1 / MSE) over all channels; +inf for identical images.
+//  - SSIM as in 3DGS (nn::ssim: 11x11 Gaussian window, σ = 1.5, zero
+//    padding, C1 = 0.01², C2 = 0.03²). Masked: the mean of the SSIM map over
+//    the mask's pixels (the windows still see the whole image).
+//  - L1 = mean absolute difference over all channels.
+// Masked values are NaN when the mask is empty.
+
+#include <ATen/ATen.h>
+
+#include <limits>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace tega::tools {
+
+double psnr(const at::Tensor& a, const at::Tensor& b);
+double psnr(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask);  // mask [H,W] bool
+at::Tensor ssim_map(const at::Tensor& a, const at::Tensor& b);                   // [H,W], mean over channels
+double ssim(const at::Tensor& a, const at::Tensor& b);
+double ssim(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask);
+double l1(const at::Tensor& a, const at::Tensor& b);
+double l1(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask);
+
+// Mean and (population) standard deviation of the finite-or-infinite values
+// given; NaN values (e.g. masked metrics of an empty mask) are left out and
+// counted apart. With an infinite value the mean is infinite and the std NaN.
+struct Statistics {
+  double mean = std::numeric_limits<double>::quiet_NaN();
+  double std = std::numeric_limits<double>::quiet_NaN();
+  int64_t count = 0;    // values that entered the statistics
+  int64_t skipped = 0;  // NaN values left out
+};
+Statistics statistics(const std::vector<double>& values);
+
+}  // namespace tega::tools

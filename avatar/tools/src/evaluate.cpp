@@ -1,0 +1,256 @@
+#include "tega/tools/evaluate.h"
+
+#include <cmath>
+#include <cstdio>
+#include <optional>
+
+#include "image_tensors.h"
+#include "tega/core/error.h"
+#include "tega/core/files.h"
+#include "tega/core/progress.h"
+#include "tega/tools/landmarks.h"
+#include "tega/tools/metrics.h"
+#include "tega/trainer/render.h"
+
+namespace tega::tools {
+
+namespace fs = std::filesystem;
+
+const std::vector<std::string>& metric_names() {
+  static const std::vector<std::string> names{"landmark_px", "lpips",       "ssim",       "psnr",
+                                              "l1",          "ssim_masked", "psnr_masked", "l1_masked"};
+  return names;
+}
+
+std::vector<SplitViews> evaluation_views(const Dataset& dataset, const std::string& split) {
+  const auto cross = [&](const std::string& name, const DatasetSplit& frames, const DatasetSplit& cameras) {
+    SplitViews s{name, {}};
+    for (const auto& f : frames.frames)
+      for (const auto& c : cameras.cameras) s.views.push_back({f, c});
+    if (s.views.empty())
+      throw Error(dataset.root / "dataset.json", "the " + name + " split has no view (no frame or no camera)");
+    return s;
+  };
+  if (split == "test") return {cross("reenactment", dataset.test, dataset.train), cross("novel_view", dataset.train, dataset.test)};
+  if (split == "train") return {cross("train", dataset.train, dataset.train)};
+  throw Error("evaluation split '" + split + "': use test (reenactment and novel view) or train");
+}
+
+std::vector<SplitResult> evaluate_avatar(trainer::TrainedAvatar& avatar, const Dataset& dataset,
+                                         const std::string& split, const Lpips* lpips) {
+  const std::vector<SplitViews> splits = evaluation_views(dataset, split);
+  const at::Device device = avatar.model.device();
+  const at::Tensor background = at::tensor(avatar.options.background, at::kFloat).to(device);
+  std::optional<LandmarkProbe> landmarks;
+  if (!dataset.landmark_vertices.empty()) landmarks.emplace(dataset, device);
+  std::optional<Lpips> lpips_here;
+  if (lpips) lpips_here = lpips->to(device);
+
+  int64_t total = 0;
+  for (const auto& s : splits) total += static_cast<int64_t>(s.views.size());
+  Progress progress("eval", total, "views");
+  at::NoGradGuard no_grad;
+  std::vector<SplitResult> results;
+  for (const SplitViews& s : splits) {
+    SplitResult result{s.name, {}};
+    std::string current_frame;
+    trainer::FrameInput input;
+    Vertices vertices;
+    at::Tensor reference_landmarks, avatar_landmarks;
+    for (const EvalView& view : s.views) {
+      if (view.frame != current_frame) {
+        current_frame = view.frame;
+        vertices = dataset.load_mesh(view.frame);
+        input = avatar.model.frame_input(vertices, dataset.frame(view.frame).head_to_world);
+        if (landmarks) {
+          reference_landmarks = landmarks->reference(vertices);
+          avatar_landmarks = landmarks->avatar(avatar.model, input, avatar.phase);
+        }
+      }
+      const Camera& camera = dataset.rig.camera(view.camera);
+      const fs::path file = dataset.image_path(view.camera, view.frame);
+      const at::Tensor rgba = detail::read_rgba(file).to(device);
+      if (rgba.size(0) != camera.height || rgba.size(1) != camera.width)
+        throw Error(file, "is " + std::to_string(rgba.size(1)) + "x" + std::to_string(rgba.size(0)) + ", camera " +
+                              view.camera + " is " + std::to_string(camera.width) + "x" + std::to_string(camera.height));
+      const at::Tensor target = trainer::composite_target(rgba, background);
+      const at::Tensor mask = rgba.select(2, 3).gt(127);  // alpha > 0.5
+      const at::Tensor rendered =
+          trainer::render_view(avatar.model, input, camera, avatar.phase, background, avatar.options.antialiased)
+              .clamp(0.0, 1.0);
+
+      ViewResult v{view.camera, view.frame, {}};
+      v.metrics["psnr"] = psnr(rendered, target);
+      v.metrics["ssim"] = ssim(rendered, target);
+      v.metrics["l1"] = l1(rendered, target);
+      v.metrics["psnr_masked"] = psnr(rendered, target, mask);
+      v.metrics["ssim_masked"] = ssim(rendered, target, mask);
+      v.metrics["l1_masked"] = l1(rendered, target, mask);
+      if (lpips_here) v.metrics["lpips"] = (*lpips_here)(rendered, target);
+      if (landmarks) v.metrics["landmark_px"] = landmark_error_px(reference_landmarks, avatar_landmarks, camera);
+      result.views.push_back(std::move(v));
+      progress.advance();
+    }
+    results.push_back(std::move(result));
+  }
+  progress.finish();
+  return results;
+}
+
+EvalNotes evaluation_notes(const Dataset& dataset, bool lpips) {
+  EvalNotes notes;
+  if (!lpips)
+    notes.lpips = "LPIPS skipped: no VGG/LPIPS weight files were given (--lpips-vgg, --lpips-lin; "
+                  "docs/render-eval-export.md#lpips-weights)";
+  notes.landmarks =
+      dataset.landmark_vertices.empty()
+          ? "landmark error skipped: the dataset defines no landmark_vertices"
+          : "landmark_px: mean pixel distance between the tracked mesh's landmark vertices and the avatar's deformed "
+            "landmark points (F + R_head D at the vertex's uv, d = 0), both projected; it measures how far the "
+            "deformation field moves the landmarks off the tracked surface, not a detector-based alignment as in the "
+            "paper";
+  return notes;
+}
+
+namespace {
+
+nlohmann::json number(double v) {
+  if (std::isnan(v)) return "nan";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  return v;
+}
+
+nlohmann::json stats_json(const std::vector<const ViewResult*>& views) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& name : metric_names()) {
+    std::vector<double> values;
+    for (const ViewResult* v : views)
+      if (const auto it = v->metrics.find(name); it != v->metrics.end()) values.push_back(it->second);
+    if (values.empty()) continue;
+    const Statistics s = statistics(values);
+    out[name] = {{"mean", number(s.mean)}, {"std", number(s.std)}, {"count", s.count}};
+    if (s.skipped > 0) out[name]["undefined"] = s.skipped;
+  }
+  return out;
+}
+
+nlohmann::json grouped(const SplitResult& split, const std::string ViewResult::*key) {
+  std::map<std::string, std::vector<const ViewResult*>> groups;
+  for (const ViewResult& v : split.views) groups[v.*key].push_back(&v);
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& [name, views] : groups) out[name] = {{"views", views.size()}, {"metrics", stats_json(views)}};
+  return out;
+}
+
+const SplitResult* find_split(const ModelResult& model, const std::string& name) {
+  for (const auto& s : model.splits)
+    if (s.name == name) return &s;
+  return nullptr;
+}
+
+std::string cell(const SplitResult* split, const std::string& metric) {
+  if (!split) return "—";
+  std::vector<double> values;
+  for (const ViewResult& v : split->views)
+    if (const auto it = v.metrics.find(metric); it != v.metrics.end()) values.push_back(it->second);
+  if (values.empty()) return "—";
+  const Statistics s = statistics(values);
+  const auto fmt = [&](double x) -> std::string {
+    if (std::isnan(x)) return "nan";
+    if (std::isinf(x)) return x > 0 ? "∞" : "-∞";
+    const int digits = metric.rfind("psnr", 0) == 0 ? 2 : metric == "landmark_px" ? 1 : metric.rfind("l1", 0) == 0 ? 4 : 3;
+    char text[64];
+    std::snprintf(text, sizeof text, "%.*f", digits, x);
+    return text;
+  };
+  return fmt(s.mean) + " ± " + fmt(s.std);
+}
+
+std::string split_title(const std::string& name) {
+  if (name == "reenactment") return "Test reenactment";
+  if (name == "novel_view") return "Novel view";
+  return "Train views";
+}
+
+const char* metric_title(const std::string& metric) {
+  static const std::map<std::string, const char*> titles{
+      {"landmark_px", "Landmark px ↓"}, {"lpips", "LPIPS ↓"},        {"ssim", "SSIM ↑"},      {"psnr", "PSNR ↑"},
+      {"l1", "L1 ↓"},                   {"ssim_masked", "SSIM ↑"}, {"psnr_masked", "PSNR ↑"}, {"l1_masked", "L1 ↓"}};
+  return titles.at(metric);
+}
+
+std::string table(const std::vector<ModelResult>& models, const std::vector<std::string>& metrics) {
+  std::vector<std::string> split_names;
+  for (const auto& m : models)
+    for (const auto& s : m.splits)
+      if (std::find(split_names.begin(), split_names.end(), s.name) == split_names.end()) split_names.push_back(s.name);
+  std::string header = "| model |", rule = "| --- |";
+  for (const auto& split : split_names)
+    for (const auto& metric : metrics) {
+      header += " " + split_title(split) + " " + metric_title(metric) + " |";
+      rule += " --- |";
+    }
+  std::string out = header + "\n" + rule + "\n";
+  for (const auto& m : models) {
+    out += "| " + m.name + " |";
+    for (const auto& split : split_names)
+      for (const auto& metric : metrics) out += " " + cell(find_split(m, split), metric) + " |";
+    out += "\n";
+  }
+  return out;
+}
+
+}  // namespace
+
+nlohmann::json evaluation_json(const std::vector<ModelResult>& models, const EvalNotes& notes) {
+  nlohmann::json doc = {{"format", "tega-eval"}, {"version", 1}};
+  doc["notes"] = {{"lpips", notes.lpips.empty() ? "evaluated (lpips vgg v0.1)" : notes.lpips},
+                  {"landmarks", notes.landmarks},
+                  {"masked", "*_masked metrics are computed inside the head mask: the dataset image's alpha > 0.5"},
+                  {"statistics", "mean and population standard deviation over views; NaN values (an empty mask) are "
+                                 "counted under 'undefined' and left out"}};
+  for (const auto& m : models) {
+    nlohmann::json model = {{"name", m.name}, {"run", m.run.string()}, {"iteration", m.iteration},
+                            {"gaussians", m.gaussians}};
+    for (const auto& split : m.splits) {
+      std::vector<const ViewResult*> all;
+      for (const auto& v : split.views) all.push_back(&v);
+      nlohmann::json views = nlohmann::json::array();
+      for (const auto& v : split.views) {
+        nlohmann::json metrics = nlohmann::json::object();
+        for (const auto& [name, value] : v.metrics) metrics[name] = number(value);
+        views.push_back({{"camera", v.camera}, {"frame", v.frame}, {"metrics", metrics}});
+      }
+      model["splits"][split.name] = {{"views", split.views.size()},
+                                     {"metrics", stats_json(all)},
+                                     {"per_camera", grouped(split, &ViewResult::camera)},
+                                     {"per_frame", grouped(split, &ViewResult::frame)},
+                                     {"per_view", views}};
+    }
+    doc["models"].push_back(model);
+  }
+  return doc;
+}
+
+std::string evaluation_markdown(const std::vector<ModelResult>& models, const EvalNotes& notes) {
+  std::string out = "# Evaluation (TeGA §5 protocol)\n\n";
+  out += "Test reenactment: held-out frames from the training cameras. Novel view: training frames from the "
+         "held-out cameras. Mean ± std over views.\n\n## Full image\n\n";
+  out += table(models, {"landmark_px", "lpips", "ssim", "psnr", "l1"});
+  out += "\n## Inside the head mask (alpha > 0.5)\n\n";
+  out += table(models, {"ssim_masked", "psnr_masked", "l1_masked"});
+  out += "\n";
+  if (!notes.lpips.empty()) out += "- " + notes.lpips + "\n";
+  out += "- " + notes.landmarks + "\n";
+  return out;
+}
+
+void write_evaluation(const std::vector<ModelResult>& models, const EvalNotes& notes, const fs::path& json_file) {
+  if (json_file.has_parent_path()) fs::create_directories(json_file.parent_path());
+  write_text_atomic(json_file, evaluation_json(models, notes).dump(2) + "\n");
+  fs::path markdown = json_file;
+  markdown.replace_extension(".md");
+  write_text_atomic(markdown, evaluation_markdown(models, notes));
+}
+
+}  // namespace tega::tools

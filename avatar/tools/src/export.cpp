@@ -1,0 +1,72 @@
+#include "tega/tools/export.h"
+
+#include <ATen/Parallel.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+
+#include "tega/trainer/spherical_harmonics.h"
+
+namespace tega::tools {
+
+namespace {
+constexpr double kC0 = 0.28209479177387814;  // Y_0^0, as in 3DGS
+}
+
+ScaleRotation decompose_covariances(const at::Tensor& covariances, double min_variance) {
+  // Double precision on the CPU: Eigen's 3x3 solver is exact to rounding and
+  // the result is stored as float32 anyway.
+  const at::Tensor packed = covariances.detach().to(at::kCPU, at::kDouble).contiguous();
+  const int64_t n = packed.size(0);
+  at::Tensor log_scale = at::empty({n, 3}, packed.options());
+  at::Tensor rotation = at::empty({n, 4}, packed.options());
+  const double* in = packed.data_ptr<double>();
+  double* scale_out = log_scale.data_ptr<double>();
+  double* rot_out = rotation.data_ptr<double>();
+  at::parallel_for(0, n, 4096, [&](int64_t begin, int64_t end) {
+    for (int64_t i = begin; i < end; ++i) {
+      const double* s = in + 6 * i;
+      Eigen::Matrix3d sigma;
+      sigma << s[0], s[1], s[2], s[1], s[3], s[4], s[2], s[4], s[5];
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(sigma);
+      Eigen::Matrix3d r = solver.eigenvectors();
+      if (r.determinant() < 0) r.col(2) = -r.col(2);  // a rotation, not a reflection
+      for (int k = 0; k < 3; ++k) scale_out[3 * i + k] = 0.5 * std::log(std::max(solver.eigenvalues()[k], min_variance));
+      Eigen::Quaterniond q(r);
+      q.normalize();
+      if (q.w() < 0) q.coeffs() = -q.coeffs();  // one of the two equivalent signs, for stable files
+      rot_out[4 * i + 0] = q.w();
+      rot_out[4 * i + 1] = q.x();
+      rot_out[4 * i + 2] = q.y();
+      rot_out[4 * i + 3] = q.z();
+    }
+  });
+  return {log_scale, rotation};
+}
+
+GaussianCloud export_frame(trainer::AvatarModel& model, const trainer::FrameInput& frame, const trainer::Phase& phase) {
+  at::NoGradGuard no_grad;
+  const trainer::PosedGaussians posed = model.pose(frame, Eigen::Vector3d::Zero(), phase);
+  const trainer::Gaussians& g = model.gaussians;
+
+  at::Tensor sh = at::cat({g.sh_dc, g.sh_rest}, 1).detach().clone();  // [N,16,3]
+  sh.slice(1, trainer::sh_coefficients(phase.sh_degree)).zero_();       // degrees the avatar does not use
+  if (phase.shading) {
+    const at::Tensor s = model.network->shade(g.uvd, posed.latents).detach().view({-1, 1});  // [N,1]
+    at::Tensor dc = sh.select(1, 0);
+    dc.copy_(((kC0 * dc + 0.5) * s - 0.5) / kC0);
+    sh.slice(1, 1).mul_(s.unsqueeze(1));
+  }
+
+  const ScaleRotation shape = decompose_covariances(posed.covariances);
+  GaussianCloud cloud;
+  cloud.means = posed.means.detach().to(at::kCPU, at::kFloat);
+  cloud.sh = sh.to(at::kCPU, at::kFloat);
+  cloud.opacity_logit = g.opacity_logit.detach().to(at::kCPU, at::kFloat);
+  cloud.log_scale = shape.log_scale.to(at::kFloat);
+  cloud.rotation = shape.rotation.to(at::kFloat);
+  return cloud;
+}
+
+}  // namespace tega::tools

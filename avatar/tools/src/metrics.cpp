@@ -1,0 +1,99 @@
+#include "tega/tools/metrics.h"
+
+#include <cmath>
+
+
+namespace tega::tools {
+
+namespace {
+
+constexpr int kWindow = 11;
+constexpr double kSigma = 1.5, kC1 = 0.01 * 0.01, kC2 = 0.03 * 0.03;
+
+void check_pair(const at::Tensor& a, const at::Tensor& b) {
+  TORCH_CHECK(a.dim() == 3 && a.sizes() == b.sizes(), "metrics compare [C,H,W] images of one size, got ", a.sizes(),
+              " and ", b.sizes());
+}
+
+double mse_to_psnr(double mse) {
+  return mse > 0 ? -10.0 * std::log10(mse) : std::numeric_limits<double>::infinity();
+}
+
+double masked_mean(const at::Tensor& per_pixel /* [H,W] */, const at::Tensor& mask) {
+  const double pixels = mask.sum().item<double>();
+  if (pixels == 0) return std::numeric_limits<double>::quiet_NaN();
+  return (per_pixel.to(at::kDouble) * mask.to(at::kDouble)).sum().item<double>() / pixels;
+}
+
+}  // namespace
+
+double psnr(const at::Tensor& a, const at::Tensor& b) {
+  check_pair(a, b);
+  return mse_to_psnr((a.to(at::kDouble) - b.to(at::kDouble)).square().mean().item<double>());
+}
+
+double psnr(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask) {
+  check_pair(a, b);
+  const double mse = masked_mean((a.to(at::kDouble) - b.to(at::kDouble)).square().mean(0), mask);
+  return std::isnan(mse) ? mse : mse_to_psnr(mse);
+}
+
+at::Tensor ssim_map(const at::Tensor& a_in, const at::Tensor& b_in) {
+  check_pair(a_in, b_in);
+  const at::Tensor a = a_in.to(at::kDouble).unsqueeze(0), b = b_in.to(at::kDouble).unsqueeze(0);
+  const int64_t channels = a.size(1);
+  const at::Tensor x = at::arange(kWindow, a.options()) - kWindow / 2;
+  at::Tensor g = at::exp(-x.square() / (2 * kSigma * kSigma));
+  g = g / g.sum();
+  const at::Tensor window = at::outer(g, g).expand({channels, 1, kWindow, kWindow}).contiguous();
+  const auto blur = [&](const at::Tensor& t) {
+    return at::conv2d(t, window, {}, /*stride=*/1, /*padding=*/kWindow / 2, /*dilation=*/1, /*groups=*/channels);
+  };
+  const at::Tensor mu_a = blur(a), mu_b = blur(b);
+  const at::Tensor var_a = blur(a * a) - mu_a * mu_a, var_b = blur(b * b) - mu_b * mu_b;
+  const at::Tensor cov = blur(a * b) - mu_a * mu_b;
+  const at::Tensor map = ((2 * mu_a * mu_b + kC1) * (2 * cov + kC2)) /
+                         ((mu_a * mu_a + mu_b * mu_b + kC1) * (var_a + var_b + kC2));
+  return map[0].mean(0);
+}
+
+double ssim(const at::Tensor& a, const at::Tensor& b) { return ssim_map(a, b).mean().item<double>(); }
+
+double ssim(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask) {
+  return masked_mean(ssim_map(a, b), mask);
+}
+
+double l1(const at::Tensor& a, const at::Tensor& b) {
+  check_pair(a, b);
+  return (a.to(at::kDouble) - b.to(at::kDouble)).abs().mean().item<double>();
+}
+
+double l1(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask) {
+  check_pair(a, b);
+  return masked_mean((a.to(at::kDouble) - b.to(at::kDouble)).abs().mean(0), mask);
+}
+
+Statistics statistics(const std::vector<double>& values) {
+  Statistics s;
+  double sum = 0;
+  bool infinite = false;
+  for (double v : values) {
+    if (std::isnan(v)) {
+      ++s.skipped;
+      continue;
+    }
+    ++s.count;
+    if (std::isinf(v)) infinite = true;
+    sum += v;
+  }
+  if (s.count == 0) return s;
+  s.mean = sum / s.count;
+  if (infinite) return s;  // mean ±inf (or NaN for +inf and -inf together), std undefined
+  double squares = 0;
+  for (double v : values)
+    if (!std::isnan(v)) squares += (v - s.mean) * (v - s.mean);
+  s.std = std::sqrt(squares / s.count);
+  return s;
+}
+
+}  // namespace tega::tools
