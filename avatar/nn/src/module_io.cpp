@@ -1,6 +1,7 @@
 #include "tega/nn/module_io.h"
 
 #include <ATen/ATen.h>
+#include <ATen/core/grad_mode.h>
 
 #include "tega/core/error.h"
 

@@ -1,5 +1,7 @@
 #include "tega/trainer/adam.h"
 
+#include <ATen/core/grad_mode.h>
+
 #include <cmath>
 
 #include "tega/core/error.h"

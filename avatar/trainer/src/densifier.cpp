@@ -1,5 +1,7 @@
 #include "tega/trainer/densifier.h"
 
+#include <ATen/core/grad_mode.h>
+
 #include <cmath>
 
 #include "tega/uvd/covariance.h"

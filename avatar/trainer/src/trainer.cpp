@@ -1,6 +1,7 @@
 #include "tega/trainer/trainer.h"
 
 #include <ATen/ATen.h>
+#include <ATen/core/grad_mode.h>
 #include <ATen/CPUGeneratorImpl.h>
 #include <ATen/Parallel.h>
 #include <spdlog/spdlog.h>
@@ -385,6 +386,8 @@ TrainSummary train(const fs::path& dataset, const fs::path& run, TrainOptions op
   fs::create_directories(run);
   write_text_atomic(run / kOptions, options_to_yaml(options));
 
+  // The networks' initial weights come from libtorch's global generator.
+  at::manual_seed(static_cast<uint64_t>(options.seed));
   Run training(dataset, run, options, control.resume);
   TrainSummary summary = training.train(control.stop_at);
 

@@ -1,6 +1,7 @@
 #include "tega/nn/expression_network.h"
 
 #include <ATen/ATen.h>
+#include <ATen/core/grad_mode.h>
 #include <gtest/gtest.h>
 
 #include "tega/core/error.h"

@@ -60,7 +60,8 @@ TEST(Trainer, ResumeReproducesAnUninterruptedRun) {
     if (name.rfind("gaussians.", 0) != 0 && name.rfind("network.", 0) != 0) continue;
     ASSERT_TRUE(b.tensors.count(name)) << name;
     ASSERT_EQ(tensor.sizes(), b.tensors.at(name).sizes()) << name;
-    EXPECT_TRUE(at::allclose(tensor, b.tensors.at(name), 1e-5, 1e-7)) << name;
+    EXPECT_TRUE(at::allclose(tensor, b.tensors.at(name), 1e-5, 1e-7))
+        << name << ": max difference " << (tensor - b.tensors.at(name)).abs().max().item<double>();
     ++compared;
   }
   EXPECT_GE(compared, 10);
