@@ -75,16 +75,16 @@ void render_performance(const Studio& studio, const std::string& take, const Dat
       const int f = first + i;
       const Surface head = studio.shader.surface(geometry[i].fine);
       const uint64_t noise = hash_of(uint64_t(o.seed), hash_string(take.c_str()), c, f);
-      const ImageF distorted = rasterize(cameras[c], {head}, o.supersampling);
+      // One render through the lens-free camera gives the dataset's
+      // undistorted image (alpha = exact coverage); the lens bends it into
+      // the captured image.
+      const ImageF pinhole = rasterize(dataset.rig.cameras[c], {head}, o.supersampling);
+      const ImageF captured = resample_through_lens(pinhole, studio.lens[c]);
       const std::string name = frame_name(f);
-      write_image(capture_image(&distorted, studio.backgrounds[c], noise, o.noise_sigma),
+      write_image(capture_image(&captured, studio.backgrounds[c], noise, o.noise_sigma),
                   studio.root / "takes" / take / cameras[c].name / (name + ".png"));
-      write_image(alpha_image(distorted), gt / "alpha" / cameras[c].name / (name + ".png"));
-      // The dataset holds undistorted images: the head seen through the same
-      // camera without its lens distortion, rendered rather than resampled so
-      // that alpha stays the exact coverage.
-      const ImageF undistorted = rasterize(dataset.rig.cameras[c], {head}, o.supersampling);
-      write_image(matte_image(undistorted, noise, o.noise_sigma), dataset.image_path(cameras[c].name, take + "_" + name));
+      write_image(alpha_image(captured), gt / "alpha" / cameras[c].name / (name + ".png"));
+      write_image(matte_image(pinhole, noise, o.noise_sigma), dataset.image_path(cameras[c].name, take + "_" + name));
       studio.progress.advance();
     });
 

@@ -123,36 +123,51 @@ ImageF rasterize(const Camera& camera, const std::vector<Surface>& surfaces, int
         }
       }
 
+      // Multisampling: coverage counts every sample, but each triangle in a
+      // pixel is shaded once, at the mean of its samples.
+      struct Group {
+        int screen_triangle, count;
+        double l1, l2;
+      };
+      std::vector<Group> groups;
       for (int py = py0; py <= py1; ++py) {
         for (int px = px0; px <= px1; ++px) {
-          Eigen::Vector3d colour = Eigen::Vector3d::Zero();
-          int covered = 0;
+          groups.clear();
           for (int j = 0; j < S; ++j) {
             for (int i = 0; i < S; ++i) {
               const Sample& smp = samples[((py - py0) * S + j) * row_samples + (px - px0) * S + i];
               if (smp.screen_triangle < 0) continue;
-              const ScreenTriangle& t = tris[smp.screen_triangle];
-              const Surface& surf = surfaces[t.surface];
-              const double l[3] = {1.0 - smp.l1 - smp.l2, smp.l1, smp.l2};
-              SurfaceSample ss;
-              ss.triangle = t.triangle;
-              for (int k = 0; k < 3; ++k) ss.barycentric[k] = float(l[k] * t.inv_z[k] / smp.inv_z);
-              ss.position.setZero();
-              ss.normal.setZero();
-              ss.uv.setZero();
-              for (int k = 0; k < 3; ++k) {
-                const int v = (*surf.faces)(t.triangle, k);
-                ss.position += ss.barycentric[k] * surf.positions->row(v).transpose();
-                ss.normal += ss.barycentric[k] * surf.normals->row(v).transpose();
-                if (surf.uvs) ss.uv += ss.barycentric[k] * surf.uvs->row((*surf.uv_faces)(t.triangle, k)).transpose();
-              }
-              if (ss.normal.squaredNorm() > 0) ss.normal.normalize();
-              ss.to_camera = (camera_centre.cast<float>() - ss.position).normalized();
-              colour += surf.shade(ss).cast<double>();
-              ++covered;
+              auto g = std::find_if(groups.begin(), groups.end(),
+                                    [&](const Group& x) { return x.screen_triangle == smp.screen_triangle; });
+              if (g == groups.end()) groups.push_back({smp.screen_triangle, 1, smp.l1, smp.l2});
+              else ++g->count, g->l1 += smp.l1, g->l2 += smp.l2;
             }
           }
-          if (!covered) continue;
+          if (groups.empty()) continue;
+          Eigen::Vector3d colour = Eigen::Vector3d::Zero();
+          int covered = 0;
+          for (const Group& g : groups) {
+            const ScreenTriangle& t = tris[g.screen_triangle];
+            const Surface& surf = surfaces[t.surface];
+            const double l[3] = {1.0 - (g.l1 + g.l2) / g.count, g.l1 / g.count, g.l2 / g.count};
+            const double inv_z = l[0] * t.inv_z[0] + l[1] * t.inv_z[1] + l[2] * t.inv_z[2];
+            SurfaceSample ss;
+            ss.triangle = t.triangle;
+            for (int k = 0; k < 3; ++k) ss.barycentric[k] = float(l[k] * t.inv_z[k] / inv_z);
+            ss.position.setZero();
+            ss.normal.setZero();
+            ss.uv.setZero();
+            for (int k = 0; k < 3; ++k) {
+              const int v = (*surf.faces)(t.triangle, k);
+              ss.position += ss.barycentric[k] * surf.positions->row(v).transpose();
+              ss.normal += ss.barycentric[k] * surf.normals->row(v).transpose();
+              if (surf.uvs) ss.uv += ss.barycentric[k] * surf.uvs->row((*surf.uv_faces)(t.triangle, k)).transpose();
+            }
+            if (ss.normal.squaredNorm() > 0) ss.normal.normalize();
+            ss.to_camera = (camera_centre.cast<float>() - ss.position).normalized();
+            colour += g.count * surf.shade(ss).cast<double>();
+            covered += g.count;
+          }
           for (int c = 0; c < 3; ++c) out.at(px, py, c) = float(colour[c] * inv_samples);
           out.at(px, py, 3) = float(covered * inv_samples);
         }

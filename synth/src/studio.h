@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "head_shader.h"
+#include "lens_resampling.h"
 #include "tega/core/dataset.h"
 #include "tega/core/progress.h"
 #include "tega/core/thread_pool.h"
@@ -27,6 +28,7 @@ struct Studio {
   const Appearance& appearance;
   const HeadShader& shader;
   const std::vector<ImageF>& backgrounds;  // per camera, noise-free
+  const std::vector<PinholeLookup>& lens;  // per camera
   ThreadPool& pool;
   Progress& progress;
 };

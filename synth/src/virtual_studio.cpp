@@ -107,8 +107,12 @@ SynthSummary render_virtual_studio(const Options& o, const std::filesystem::path
   Progress progress("synth", total, "images");
 
   std::vector<ImageF> backgrounds(n_cameras);
-  pool.parallel_for(0, n_cameras, [&](int64_t c) { backgrounds[c] = backdrop.render(rig.cameras[c]); });
-  const Studio studio{o, root, head, maker, rig, appearance, shader, backgrounds, pool, progress};
+  std::vector<PinholeLookup> lens(n_cameras);
+  pool.parallel_for(0, n_cameras, [&](int64_t c) {
+    backgrounds[c] = backdrop.render(rig.cameras[c]);
+    lens[c] = pinhole_lookup(rig.cameras[c]);
+  });
+  const Studio studio{o, root, head, maker, rig, appearance, shader, backgrounds, lens, pool, progress};
 
   write_rig_json(rig, root / "rig.json");
   write_head_ground_truth(root / "ground_truth" / "head", head, maker);

@@ -36,6 +36,8 @@ struct Surface {
 };
 
 // RGBA, premultiplied: rgb = sum of the shaded samples / S^2, a = coverage.
+// `camera`'s distortion is honoured; pass a camera without distortion for a
+// pinhole image.
 ImageF rasterize(const Camera& camera, const std::vector<Surface>& surfaces, int supersampling);
 
 }  // namespace tega::synth
