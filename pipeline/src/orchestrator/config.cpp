@@ -7,6 +7,7 @@
 
 #include "tega/core/error.h"
 #include "tega/core/files.h"
+#include "tega/pipeline/stage_kinds.h"
 
 namespace tega::pipeline {
 namespace fs = std::filesystem;
@@ -35,8 +36,8 @@ class Reader {
       if (std::find(known.begin(), known.end(), key) != known.end()) continue;
       std::string list;
       for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
-      fail(entry.first, "unknown key '" + (where.empty() ? key : where + "." + key) + "'; known keys" +
-                            (where.empty() ? "" : " of '" + where + "'") + ": " + list);
+      throw Error(source_, "unknown key '" + (where.empty() ? key : where + "." + key) + "'" + line_of(entry.first) +
+                               "; known keys" + (where.empty() ? "" : " of '" + where + "'") + ": " + list);
     }
   }
 
@@ -117,7 +118,16 @@ fs::path resolve(const fs::path& base_dir, const std::string& path) {
   return (base_dir / path).lexically_normal();
 }
 
-StageConfig read_stage(const Reader& r, const std::string& name, const YAML::Node& node, const fs::path& base_dir) {
+// The section of an options file that a kind's command reads.
+std::string options_section_of(const std::string& kind_name) {
+  const StageKind* kind = find_stage_kind(kind_name);
+  return kind ? kind->options_section : "";
+}
+
+// `claimed_sections` collects the top-level keys of the config itself that a
+// stage reads its options from (`options_file` naming the config).
+StageConfig read_stage(const Reader& r, const std::string& name, const YAML::Node& node, const fs::path& base_dir,
+                       const YAML::Node& config_root, std::vector<std::string>& claimed_sections) {
   const std::string where = "stages." + name;
   StageConfig stage;
   stage.name = name;
@@ -130,12 +140,19 @@ StageConfig read_stage(const Reader& r, const std::string& name, const YAML::Nod
   YAML::Node options;
   if (node["options_file"]) {
     const fs::path file = resolve(base_dir, r.scalar(node["options_file"], where + ".options_file"));
-    options = parse_yaml(read_text_file(file), file);
+    const bool is_config_itself = fs::exists(file) && fs::exists(r.source()) && fs::equivalent(file, r.source());
+    const YAML::Node document = is_config_itself ? config_root : parse_yaml(read_text_file(file), file);
+    const std::string section = options_section_of(stage.kind);
+    options.reset(section.empty() ? document : document[section]);
+    if (!section.empty()) {
+      if (!options) throw Error(file, "has no '" + section + "' section (the options of stage '" + name + "')");
+      if (is_config_itself) claimed_sections.push_back(section);
+    }
     if (!options.IsNull() && !options.IsMap()) throw Error(file, "must be a mapping of option names to values");
   }
   if (node["options"]) {
     if (!node["options"].IsNull()) r.require_map(node["options"], where + ".options");
-    options = merged(options, node["options"]);
+    options.reset(merged(options, node["options"]));  // reset: `options` may alias the config's own section
   }
   stage.options_yaml = canonical_yaml(options);
   return stage;
@@ -183,7 +200,6 @@ PipelineConfig parse_pipeline_config(const std::string& text, const fs::path& so
   const Reader r(source);
   const YAML::Node root = parse_yaml(text, source);
   if (!root.IsMap()) throw Error(source, "must be a mapping with 'workspace' and 'stages'");
-  r.check_keys(root, "", {"description", "workspace", "subjects", "stages"});
 
   PipelineConfig config;
   config.source = source;
@@ -193,17 +209,19 @@ PipelineConfig parse_pipeline_config(const std::string& text, const fs::path& so
   config.workspace = resolve(config.base_dir, r.scalar(root["workspace"], "workspace"));
 
   const YAML::Node stages = root["stages"];
-  if (!stages || !stages.IsMap() || stages.size() == 0) {
-    throw Error(source, "needs 'stages', a mapping of stage names to stage sections");
-  }
   std::set<std::string> stage_names;
-  for (const auto& e : stages) {
-    const auto name = e.first.as<std::string>();
-    check_name(r, e.first, "stage name", name);
-    if (name == "logs") r.fail(e.first, "stage name 'logs' is reserved for the workspace's log folder");
-    config.stages.push_back(read_stage(r, name, e.second, config.base_dir));
-    stage_names.insert(name);
+  std::vector<std::string> known_keys = {"description", "workspace", "subjects", "stages"};
+  if (stages && stages.IsMap()) {
+    for (const auto& e : stages) {
+      const auto name = e.first.as<std::string>();
+      check_name(r, e.first, "stage name", name);
+      if (name == "logs") r.fail(e.first, "stage name 'logs' is reserved for the workspace's log folder");
+      config.stages.push_back(read_stage(r, name, e.second, config.base_dir, root, known_keys));
+      stage_names.insert(name);
+    }
   }
+  r.check_keys(root, "", known_keys);
+  if (config.stages.empty()) throw Error(source, "needs 'stages', a mapping of stage names to stage sections");
 
   if (const YAML::Node subjects = root["subjects"]) {
     r.require_map(subjects, "subjects");
@@ -219,6 +237,43 @@ PipelineConfig parse_pipeline_config(const std::string& text, const fs::path& so
 
 PipelineConfig load_pipeline_config(const fs::path& file) {
   return parse_pipeline_config(read_text_file(file), file, fs::absolute(file).parent_path());
+}
+
+std::string options_file_text(const std::string& options_yaml, const std::string& section) {
+  if (section.empty()) return options_yaml;
+  YAML::Node wrapped;
+  wrapped[section] = options_yaml.empty() ? YAML::Node(YAML::NodeType::Map) : YAML::Load(options_yaml);
+  return canonical_yaml(wrapped);
+}
+
+std::vector<std::string> option_keys(const std::string& options_yaml) {
+  std::vector<std::string> keys;
+  if (options_yaml.empty()) return keys;
+  for (const auto& e : YAML::Load(options_yaml)) keys.push_back(e.first.as<std::string>());
+  return keys;
+}
+
+std::vector<std::string> option_flags(const std::string& options_yaml) {
+  std::vector<std::string> flags;
+  if (options_yaml.empty()) return flags;
+  for (const auto& e : YAML::Load(options_yaml)) {
+    std::string flag = "--" + e.first.as<std::string>();
+    std::replace(flag.begin(), flag.end(), '_', '-');
+    const YAML::Node& value = e.second;
+    if (value.IsSequence()) {
+      for (const auto& item : value) flags.insert(flags.end(), {flag, item.as<std::string>()});
+    } else if (value.IsScalar()) {
+      const std::string text = value.as<std::string>();
+      if (value.Tag() != "!" && (text == "true" || text == "false")) {
+        if (text == "true") flags.push_back(flag);
+      } else {
+        flags.insert(flags.end(), {flag, text});
+      }
+    } else if (!value.IsNull()) {
+      throw Error("option '" + e.first.as<std::string>() + "' is a mapping, which no command-line flag takes");
+    }
+  }
+  return flags;
 }
 
 std::optional<std::string> scalar_option(const std::string& options_yaml, const std::string& dotted_key) {

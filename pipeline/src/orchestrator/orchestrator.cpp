@@ -161,7 +161,11 @@ class Run {
              "is not up to date and its stage is not selected: run it first (drop --only/--from)");
       return;
     }
-    launch(s);
+    try {
+      launch(s);
+    } catch (const std::exception& e) {
+      fail(s, std::string("could not be started: ") + e.what());
+    }
   }
 
   void launch(ShardRun& s) {
@@ -174,9 +178,11 @@ class Run {
     ShardPaths paths;
     paths.output = staging;
     paths.capture = subject.capture;
-    if (stage.kind->takes_options) {
+    if (stage.kind->options_as == OptionsAs::config_file) {
       paths.options_file = staging / "options.yaml";
-      write_text_atomic(paths.options_file, s.fingerprint.options_yaml);
+      write_text_atomic(paths.options_file, options_file_text(s.fingerprint.options_yaml, stage.kind->options_section));
+    } else if (stage.kind->options_as == OptionsAs::flags) {
+      paths.option_flags = option_flags(s.fingerprint.options_yaml);
     }
     for (const auto& [artifact, source] : stage.artifact_source) {
       paths.artifacts[artifact] =

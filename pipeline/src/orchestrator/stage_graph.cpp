@@ -21,6 +21,24 @@ std::string known_kinds() {
   return join(names, ", ");
 }
 
+// Options a command could not take are config errors, found before anything runs.
+void check_options(const PipelineConfig& config, const StageConfig& stage, const StageKind& kind) {
+  std::vector<std::string> sources = {stage.options_yaml};
+  for (const auto& subject : config.subjects) {
+    if (subject.stage_options.count(stage.name)) sources.push_back(subject.stage_options.at(stage.name));
+  }
+  const std::string what = "stage '" + stage.name + "' (kind " + kind.name + ")";
+  for (const auto& options : sources) {
+    if (kind.options_as == OptionsAs::none && !options.empty()) throw Error(config.source, what + " takes no options");
+    if (kind.options_as != OptionsAs::flags) continue;
+    for (const auto& key : option_keys(options)) {
+      if (std::find(kind.flag_options.begin(), kind.flag_options.end(), key) == kind.flag_options.end()) {
+        throw Error(config.source, what + ": unknown option '" + key + "'; known options: " + join(kind.flag_options, ", "));
+      }
+    }
+  }
+}
+
 }  // namespace
 
 StageGraph::StageGraph(PipelineConfig config, const CommandAvailable& available) : config_(std::move(config)) {
@@ -39,9 +57,7 @@ StageGraph::StageGraph(PipelineConfig config, const CommandAvailable& available)
     if (!stage.kind) {
       throw Error(source, "stage '" + sc.name + "': unknown kind '" + sc.kind + "'; known kinds: " + known_kinds());
     }
-    if (!stage.kind->takes_options && !sc.options_yaml.empty()) {
-      throw Error(source, "stage '" + sc.name + "' (kind " + sc.kind + ") takes no options");
-    }
+    check_options(config_, sc, *stage.kind);
     for (const auto& up : sc.after) {
       const auto it = by_name.find(up);
       if (it == by_name.end()) throw Error(source, "stage '" + sc.name + "': 'after' names no stage: '" + up + "'");

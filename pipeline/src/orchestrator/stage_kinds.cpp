@@ -8,6 +8,11 @@ std::vector<std::string> with_config(std::vector<std::string> arguments, const S
   return arguments;
 }
 
+std::vector<std::string> with_flags(std::vector<std::string> arguments, const ShardPaths& p) {
+  arguments.insert(arguments.end(), p.option_flags.begin(), p.option_flags.end());
+  return arguments;
+}
+
 // A stage of the capture chain that tega does not implement yet: declared so
 // that capture-based configs describe their whole graph and report it honestly.
 StageKind not_implemented(std::string name, std::string summary, std::vector<std::string> needs,
@@ -37,6 +42,7 @@ std::vector<StageKind> make_stage_kinds() {
   ingest.summary = "a Multiface capture converted to a dataset (tega ingest multiface)";
   ingest.subcommand = {"ingest", "multiface"};
   ingest.provides = {{"dataset", "dataset"}};
+  ingest.options_section = "ingest";
   ingest.reads_capture = true;
   ingest.arguments = [](const ShardPaths& p) {
     return with_config({"--capture", p.capture.string(), "--out", (p.output / "dataset").string()}, p);
@@ -48,7 +54,7 @@ std::vector<StageKind> make_stage_kinds() {
   check.summary = "checks a dataset the way training does (tega dataset check)";
   check.subcommand = {"dataset", "check"};
   check.needs = {"dataset"};
-  check.takes_options = false;
+  check.options_as = OptionsAs::none;
   check.arguments = [](const ShardPaths& p) {
     return std::vector<std::string>{"--data", p.artifacts.at("dataset").string()};
   };
@@ -67,33 +73,40 @@ std::vector<StageKind> make_stage_kinds() {
   };
   kinds.push_back(train);
 
-  // eval and render plug in once their commands exist (issue 5); until then
-  // the running binary lacks the subcommand and the stage reports itself unavailable.
+  // eval and render take their options as flags (`tega eval --help`). The
+  // stage reports itself unavailable while the running binary lacks the command.
   StageKind eval;
   eval.name = "eval";
-  eval.summary = "evaluates a trained avatar on the dataset's test split: the eval table (tega eval)";
+  eval.summary = "evaluates a trained avatar with the paper's protocol: the eval table (tega eval)";
   eval.subcommand = {"eval"};
   eval.needs = {"run", "dataset"};
-  eval.provides = {{"eval", "eval"}};
+  eval.provides = {{"eval", "eval.json"}, {"eval_table", "eval.md"}};
+  eval.options_as = OptionsAs::flags;
+  eval.flag_options = {"split", "lpips_vgg", "lpips_lin", "device"};
+  eval.path_options = {"lpips_vgg", "lpips_lin"};
   eval.device_option = "device";
   eval.arguments = [](const ShardPaths& p) {
-    return with_config({"--run", p.artifacts.at("run").string(), "--data", p.artifacts.at("dataset").string(),
-                        "--out", (p.output / "eval").string()},
-                       p);
+    return with_flags({"--model", p.artifacts.at("run").string(), "--data", p.artifacts.at("dataset").string(),
+                       "--json", (p.output / "eval.json").string()},
+                      p);
   };
   kinds.push_back(eval);
 
   StageKind render;
   render.name = "render";
-  render.summary = "renders a trained avatar from the dataset's cameras (tega render)";
+  render.summary = "renders a trained avatar to images and videos (tega render)";
   render.subcommand = {"render"};
   render.needs = {"run", "dataset"};
   render.provides = {{"renders", "renders"}};
+  render.options_as = OptionsAs::flags;
+  render.flag_options = {"cameras", "orbit", "camera_file", "frames", "width", "height", "format",
+                         "no_side_by_side", "no_video", "fps", "device"};
+  render.path_options = {"camera_file"};
   render.device_option = "device";
   render.arguments = [](const ShardPaths& p) {
-    return with_config({"--run", p.artifacts.at("run").string(), "--data", p.artifacts.at("dataset").string(),
-                        "--out", (p.output / "renders").string()},
-                       p);
+    return with_flags({"--model", p.artifacts.at("run").string(), "--data", p.artifacts.at("dataset").string(),
+                       "--out", (p.output / "renders").string()},
+                      p);
   };
   kinds.push_back(render);
 

@@ -17,7 +17,9 @@ struct StageConfig {
   std::string name;                // the key under `stages`
   std::string kind;                // `kind`, default: the name (docs/pipeline.md#stage-kinds)
   std::vector<std::string> after;  // upstream stages
-  std::string options_yaml;        // `options_file` with `options` merged over it; canonical YAML, "" = none
+  // `options_file` (a file in the command's own --config format) with
+  // `options` merged over it; canonical YAML, "" = none.
+  std::string options_yaml;
 };
 
 struct SubjectConfig {
@@ -41,6 +43,15 @@ struct PipelineConfig {
 PipelineConfig load_pipeline_config(const std::filesystem::path& file);  // throws tega::Error naming the file
 PipelineConfig parse_pipeline_config(const std::string& text, const std::filesystem::path& source,
                                      const std::filesystem::path& base_dir);
+
+// Options as the text of a --config file that reads them from `section` ("" = the whole document).
+std::string options_file_text(const std::string& options_yaml, const std::string& section);
+
+// Options as command-line flags: `key: value` -> --key value (underscores
+// become hyphens), `key: true` -> --key, `key: false` -> nothing, a list ->
+// the flag once per item. Throws tega::Error for a mapping value.
+std::vector<std::string> option_flags(const std::string& options_yaml);
+std::vector<std::string> option_keys(const std::string& options_yaml);  // the top-level keys
 
 // The value of a scalar option (dotted key: "loss.vgg_weights") in options YAML, if set.
 std::optional<std::string> scalar_option(const std::string& options_yaml, const std::string& dotted_key);

@@ -16,9 +16,17 @@ namespace tega::pipeline {
 // Where one shard's command reads and writes; every path is absolute.
 struct ShardPaths {
   std::filesystem::path output;        // the shard's staging directory: outputs go under it
-  std::filesystem::path options_file;  // the stage's options as a YAML file; empty for kinds without options
+  std::filesystem::path options_file;  // OptionsAs::config_file: the stage's options as a YAML file
+  std::vector<std::string> option_flags;  // OptionsAs::flags: the stage's options as flags
   std::map<std::string, std::filesystem::path> artifacts;  // each needed artifact -> its path
   std::filesystem::path capture;       // the subject's capture directory (kinds that read one)
+};
+
+// How a shard's command receives the stage's options.
+enum class OptionsAs {
+  none,         // the command takes no options
+  config_file,  // --config FILE, a YAML file (under `options_section` when that is set)
+  flags,        // each option `key: value` becomes `--key value` (see option_flags())
 };
 
 struct StageKind {
@@ -29,7 +37,9 @@ struct StageKind {
   std::vector<std::string> subcommand;
   std::vector<std::string> needs;                        // artifacts taken from upstream stages
   std::map<std::string, std::string> provides;           // artifact -> path inside the shard directory
-  bool takes_options = true;                             // options are passed as --config FILE
+  OptionsAs options_as = OptionsAs::config_file;
+  std::string options_section;                           // config_file: the section the command reads, "" = all
+  std::vector<std::string> flag_options;                 // flags: the options the command has
   bool reads_capture = false;                            // the subject's `capture` is an input
   std::vector<std::string> path_options;                 // options that name external input files
   std::string device_option;                             // option naming the device ("cuda..." = a GPU stage)

@@ -1,0 +1,161 @@
+#include "tega/pipeline/config.h"
+
+#include <gtest/gtest.h>
+
+#include "tega/pipeline/stage_graph.h"
+#include "test_support.h"
+
+namespace tega::pipeline {
+namespace {
+
+PipelineConfig parse(const std::string& text) { return parse_pipeline_config(text, "/cfg/p.yaml", "/cfg"); }
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+bool all_commands(const std::vector<std::string>&) { return true; }
+
+TEST(PipelineConfig, ReadsWorkspaceSubjectsAndStagesRelativeToTheConfig) {
+  const auto c = parse(
+      "workspace: ../ws\n"
+      "subjects:\n  alice: {capture: caps/alice}\n  bob: {options: {synth: {seed: 2}}}\n"
+      "stages:\n  synth: {options: {frames: 3}}\n  check: {kind: dataset_check, after: synth}\n");
+  EXPECT_EQ(c.workspace, "/ws");
+  ASSERT_EQ(c.subjects.size(), 2u);
+  EXPECT_EQ(c.subjects[0].capture, "/cfg/caps/alice");
+  ASSERT_EQ(c.stages.size(), 2u);
+  EXPECT_EQ(c.stages[0].kind, "synth");
+  EXPECT_EQ(c.stages[1].kind, "dataset_check");
+  EXPECT_EQ(c.stages[1].after, std::vector<std::string>{"synth"});
+  EXPECT_EQ(c.options_for(c.stages[0], c.subjects[0]), "frames: 3\n");
+  EXPECT_EQ(c.options_for(c.stages[0], c.subjects[1]), "frames: 3\nseed: 2\n");
+}
+
+TEST(PipelineConfig, WithoutSubjectsHasOneDefaultSubject) {
+  const auto c = parse("workspace: ws\nstages:\n  synth:\n");
+  ASSERT_EQ(c.subjects.size(), 1u);
+  EXPECT_EQ(c.subjects[0].name, "default");
+}
+
+TEST(PipelineConfig, OptionsAreCanonicalWhateverTheirOrderAndLayout) {
+  const auto a = parse("workspace: ws\nstages:\n  synth:\n    options:\n      seed: 1\n      studio: {width: 64, cameras: 2}\n");
+  const auto b = parse("workspace: ws\nstages:\n  synth: {options: {studio: {cameras: 2, width: 64}, seed: 1}}\n");
+  EXPECT_EQ(a.stages[0].options_yaml, b.stages[0].options_yaml);
+  const auto quoted = parse("workspace: ws\nstages:\n  synth: {options: {head: \"1\"}}\n");
+  EXPECT_NE(quoted.stages[0].options_yaml, parse("workspace: ws\nstages:\n  synth: {options: {head: 1}}\n").stages[0].options_yaml);
+}
+
+TEST(PipelineConfig, OptionsFileIsTheBaseThatOptionsOverride) {
+  test::TempDir dir;
+  test::write_text(dir / "rig.yaml", "frames: 30\nstudio: {cameras: 13, width: 512}\n");
+  test::write_text(dir / "p.yaml",
+                   "workspace: ws\nstages:\n  synth: {options_file: rig.yaml, options: {studio: {cameras: 6}}}\n");
+  const auto c = load_pipeline_config(dir / "p.yaml");
+  EXPECT_EQ(c.stages[0].options_yaml, "frames: 30\nstudio:\n  cameras: 6\n  width: 512\n");
+  EXPECT_EQ(scalar_option(c.stages[0].options_yaml, "studio.cameras"), "6");
+  EXPECT_EQ(scalar_option(c.stages[0].options_yaml, "studio.height"), std::nullopt);
+}
+
+TEST(PipelineConfig, AStageMayReadItsOptionsFromASectionOfTheConfigItself) {
+  test::TempDir dir;
+  const std::string stages = "stages:\n  ingest: {kind: ingest_multiface, options_file: p.yaml, options: {frames: 9}}\n";
+  test::write_text(dir / "p.yaml", "ingest:\n  frames: 400\n  downsample: 2\nworkspace: ws\n" + stages);
+  const auto c = load_pipeline_config(dir / "p.yaml");
+  EXPECT_EQ(c.stages[0].options_yaml, "downsample: 2\nframes: 9\n");
+  // The command reads the `ingest` section of the file it is given.
+  EXPECT_EQ(options_file_text(c.stages[0].options_yaml, "ingest"), "ingest:\n  downsample: 2\n  frames: 9\n");
+
+  // Without a stage reading it, the section is an unknown key like any other.
+  test::write_text(dir / "q.yaml", "ingest:\n  frames: 400\nworkspace: ws\nstages: {synth: }\n");
+  EXPECT_NE(error_of([&] { load_pipeline_config(dir / "q.yaml"); }).find("unknown key 'ingest' (line 1)"),
+            std::string::npos);
+}
+
+TEST(PipelineConfig, OptionsBecomeFlagsForCommandsWithoutAConfigFile) {
+  EXPECT_EQ(option_flags("device: cpu\nno_video: true\nno_side_by_side: false\nframes: [a, b]\nformat: \"true\"\n"),
+            (std::vector<std::string>{"--device", "cpu", "--no-video", "--frames", "a", "--frames", "b", "--format",
+                                      "true"}));
+  EXPECT_NE(error_of([] { option_flags("orbit: {n: 3}\n"); }).find("option 'orbit' is a mapping"), std::string::npos);
+  EXPECT_NE(error_of([] {
+              StageGraph(parse("workspace: ws\nstages: {synth: , train: {after: synth}, "
+                               "render: {after: train, options: {widht: 64}}}\n"),
+                         all_commands);
+            }).find("stage 'render' (kind render): unknown option 'widht'; known options: cameras, orbit"),
+            std::string::npos);
+}
+
+TEST(PipelineConfig, UnknownKeysAreErrorsNamingTheFileAndTheKnownKeys) {
+  EXPECT_EQ(error_of([] { parse("workspace: ws\nstage: {}\n"); }),
+            "/cfg/p.yaml: unknown key 'stage' (line 2); known keys: description, workspace, subjects, stages");
+  EXPECT_EQ(error_of([] { parse("workspace: ws\nstages:\n  synth: {option: {}}\n"); }),
+            "/cfg/p.yaml: unknown key 'stages.synth.option' (line 3); known keys of 'stages.synth': kind, after, "
+            "options, options_file");
+  EXPECT_NE(error_of([] { parse("workspace: ws\nsubjects: {a: {options: {trian: {}}}}\nstages: {train: }\n"); })
+                .find("'subjects.a.options.trian' names no stage"),
+            std::string::npos);
+  EXPECT_NE(error_of([] { parse("stages: {synth: }\n"); }).find("/cfg/p.yaml: needs 'workspace'"), std::string::npos);
+  EXPECT_NE(error_of([] { parse("workspace: ws\nsubjects: {../x: {}}\nstages: {synth: }\n"); }).find("subject name '../x'"),
+            std::string::npos);
+}
+
+TEST(StageGraph, OrdersStagesDependenciesFirstAndFindsArtifacts) {
+  const StageGraph g(parse("workspace: ws\nstages:\n"
+                           "  eval: {after: train}\n  train: {after: synth}\n  synth:\n"),
+                     all_commands);
+  ASSERT_EQ(g.stages().size(), 3u);
+  EXPECT_EQ(g.stages()[0].name(), "synth");
+  EXPECT_EQ(g.stages()[1].name(), "train");
+  EXPECT_EQ(g.stages()[2].name(), "eval");
+  // eval needs the run (from train) and the dataset, which comes from synth through train.
+  EXPECT_EQ(g.stages()[2].artifact_source.at("run"), 1u);
+  EXPECT_EQ(g.stages()[2].artifact_source.at("dataset"), 0u);
+  EXPECT_EQ(g.stages()[2].inputs, (std::vector<size_t>{0, 1}));
+  EXPECT_EQ(g.downstream_of(1), (std::vector<bool>{false, true, true}));
+  EXPECT_EQ(g.upstream_of({false, true, false}), (std::vector<bool>{true, true, false}));
+}
+
+TEST(StageGraph, RejectsUnknownKindsCyclesAndMissingArtifacts) {
+  EXPECT_NE(error_of([] { StageGraph(parse("workspace: ws\nstages: {x: {kind: sinth}}\n"), all_commands); })
+                .find("stage 'x': unknown kind 'sinth'; known kinds: synth, ingest_multiface, dataset_check"),
+            std::string::npos);
+  EXPECT_NE(error_of([] {
+              StageGraph(parse("workspace: ws\nstages: {a: {kind: synth, after: b}, b: {kind: synth, after: a}}\n"),
+                         all_commands);
+            }).find("form a cycle: a -> b -> a"),
+            std::string::npos);
+  EXPECT_NE(error_of([] { StageGraph(parse("workspace: ws\nstages: {train: }\n"), all_commands); })
+                .find("stage 'train' (kind train) needs a dataset"),
+            std::string::npos);
+  EXPECT_NE(error_of([] { StageGraph(parse("workspace: ws\nstages: {synth: , check: {kind: dataset_check, after: synth, "
+                                           "options: {x: 1}}}\n"),
+                                     all_commands); })
+                .find("stage 'check' (kind dataset_check) takes no options"),
+            std::string::npos);
+}
+
+TEST(StageGraph, StagesWithoutACommandAreUnavailableWithTheReason) {
+  const StageGraph g(parse("workspace: ws\nstages:\n  capture:\n  calibrate: {after: capture}\n"
+                           "  synth:\n  train: {after: synth}\n"
+                           "  eval: {after: [train]}\n"),
+                     [](const std::vector<std::string>& command) { return command[0] != "eval"; });
+  for (const auto& stage : g.stages()) {
+    if (stage.name() == "capture" || stage.name() == "calibrate") {
+      EXPECT_FALSE(stage.available);
+      EXPECT_NE(stage.unavailable_reason.find("not implemented in tega yet"), std::string::npos);
+    } else if (stage.name() == "eval") {
+      EXPECT_FALSE(stage.available);
+      EXPECT_EQ(stage.unavailable_reason, "`tega eval` is not available in this build");
+    } else {
+      EXPECT_TRUE(stage.available) << stage.name();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace tega::pipeline

@@ -1,0 +1,106 @@
+#include "tega/pipeline/local_executor.h"
+
+#include <gtest/gtest.h>
+
+#include "tega/core/files.h"
+#include "test_support.h"
+
+namespace tega::pipeline {
+namespace {
+
+using namespace std::chrono_literals;
+
+Job shell_job(const std::string& id, const std::string& script, const test::TempDir& dir, const std::string& gpu = "") {
+  Job job;
+  job.id = id;
+  job.argv = {"/bin/sh", "-c", script};
+  job.working_directory = dir.path();
+  job.log_file = dir / ("logs/" + id + ".log");
+  job.resources.gpu_device = gpu;
+  return job;
+}
+
+std::vector<JobResult> wait_for_all(Executor& executor, std::chrono::seconds timeout) {
+  std::vector<JobResult> results;
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (executor.unfinished() > 0 && std::chrono::steady_clock::now() < deadline) {
+    for (auto& r : executor.wait(100ms)) results.push_back(r);
+  }
+  return results;
+}
+
+// A job that fails if another job holding the same directory "lock" runs at the same time.
+std::string exclusive(const std::string& lock) { return "mkdir " + lock + " || exit 3; sleep 0.2; rmdir " + lock; }
+
+// Two jobs that each wait for the other to have started: they only succeed when run together.
+std::string rendezvous(const std::string& mine, const std::string& other) {
+  return "touch " + mine + "; i=0; while [ ! -e " + other + " ]; do i=$((i+1)); [ $i -gt 300 ] && exit 4; sleep 0.01; done";
+}
+
+TEST(LocalExecutor, RunsCpuJobsInParallelUpToItsSlots) {
+  test::TempDir dir;
+  LocalExecutor executor(2);
+  executor.submit(shell_job("a", rendezvous("a.started", "b.started"), dir));
+  executor.submit(shell_job("b", rendezvous("b.started", "a.started"), dir));
+  const auto results = wait_for_all(executor, 20s);
+  ASSERT_EQ(results.size(), 2u);
+  for (const auto& r : results) EXPECT_TRUE(r.succeeded) << r.id << ": " << r.failure;
+}
+
+TEST(LocalExecutor, RunsOneCpuJobAtATimeWithOneSlot) {
+  test::TempDir dir;
+  LocalExecutor executor(1);
+  for (const char* id : {"a", "b", "c"}) executor.submit(shell_job(id, exclusive("lock"), dir));
+  const auto results = wait_for_all(executor, 20s);
+  ASSERT_EQ(results.size(), 3u);
+  for (const auto& r : results) EXPECT_TRUE(r.succeeded) << r.id << ": " << r.failure;
+}
+
+TEST(LocalExecutor, SerializesJobsPerGpuDeviceButNotAcrossDevices) {
+  test::TempDir dir;
+  LocalExecutor executor(8);
+  for (const char* id : {"g1", "g2", "g3"}) executor.submit(shell_job(id, exclusive("gpu0"), dir, "cuda:0"));
+  executor.submit(shell_job("x", rendezvous("x.started", "y.started"), dir, "cuda:1"));
+  executor.submit(shell_job("y", rendezvous("y.started", "x.started"), dir, "cuda:2"));
+  const auto results = wait_for_all(executor, 30s);
+  ASSERT_EQ(results.size(), 5u);
+  for (const auto& r : results) EXPECT_TRUE(r.succeeded) << r.id << ": " << r.failure;
+}
+
+TEST(LocalExecutor, ReportsFailuresAndAppendsOutputToTheLog) {
+  test::TempDir dir;
+  LocalExecutor executor(2);
+  executor.submit(shell_job("fails", "echo something went wrong >&2; exit 7", dir));
+  executor.submit([&] {
+    Job job = shell_job("no-program", "", dir);
+    job.argv = {(dir / "no-such-program").string()};
+    return job;
+  }());
+  auto results = wait_for_all(executor, 20s);
+  ASSERT_EQ(results.size(), 2u);
+  std::map<std::string, JobResult> by_id;
+  for (auto& r : results) by_id[r.id] = r;
+  EXPECT_FALSE(by_id["fails"].succeeded);
+  EXPECT_EQ(by_id["fails"].failure, "exit code 7");
+  EXPECT_EQ(by_id["no-program"].failure, "exit code 127");
+  const std::string log = read_text_file(dir / "logs/fails.log");
+  EXPECT_EQ(log.rfind("=== ", 0), 0u) << log;
+  EXPECT_NE(log.find("something went wrong"), std::string::npos) << log;
+}
+
+TEST(LocalExecutor, CancelStopsRunningJobsAndDropsQueuedOnes) {
+  test::TempDir dir;
+  LocalExecutor executor(1, 2s);
+  executor.submit(shell_job("sleeper", "touch started; sleep 60", dir));
+  executor.submit(shell_job("queued", "touch queued-ran", dir));
+  while (!std::filesystem::exists(dir / "started")) executor.wait(20ms);
+  const auto start = std::chrono::steady_clock::now();
+  executor.cancel_all();
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 2s);  // SIGTERM was enough
+  EXPECT_EQ(executor.unfinished(), 0u);
+  EXPECT_TRUE(executor.wait(100ms).empty());
+  EXPECT_FALSE(std::filesystem::exists(dir / "queued-ran"));
+}
+
+}  // namespace
+}  // namespace tega::pipeline

@@ -1,0 +1,254 @@
+// `tega run` and `tega status` on small virtual-studio pipelines: skipping,
+// re-running exactly what changed, failures that stay contained, Ctrl-C.
+
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "pipeline_test_support.h"
+#include "tega/core/files.h"
+#include "test_support.h"
+
+namespace tega::test {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+#define REQUIRE_SYNTH() \
+  if (!tega_has_command({"synth"})) GTEST_SKIP() << "this build has no `tega synth`"
+
+// Two independent chains: synth_a -> check_a and synth_b -> check_b.
+std::string two_chains_config(const std::string& b_extra) {
+  return "workspace: ws\nstages:\n  synth_a:\n    kind: synth\n    options:\n" + tiny_synth_options(6) +
+         "  check_a: {kind: dataset_check, after: synth_a}\n  synth_b:\n    kind: synth\n    options:\n" +
+         tiny_synth_options(6) + b_extra + "  check_b: {kind: dataset_check, after: synth_b}\n";
+}
+
+std::string two_subjects_config(const std::string& bob_synth_options) {
+  return "workspace: ws\nsubjects:\n  alice: {}\n  bob: {options: {synth: {" + bob_synth_options +
+         "}}}\nstages:\n  synth:\n    options:\n" + tiny_synth_options(6) +
+         "  check: {kind: dataset_check, after: synth}\n";
+}
+
+json status_json(const fs::path& target, const fs::path& scratch) {
+  const auto r = run_tega({"status", target.string(), "--json"}, scratch);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  return json::parse(r.output);
+}
+
+std::string shard_state(const json& status, const std::string& stage, const std::string& shard) {
+  for (const auto& s : status["stages"]) {
+    if (s["stage"] != stage) continue;
+    for (const auto& sh : s["shards"]) {
+      if (sh["shard"] == shard) return sh["state"];
+    }
+  }
+  return "(absent)";
+}
+
+TEST(TegaRun, SkipsDoneShardsAndReRunsOnlyWhatAChangedOptionReaches) {
+  REQUIRE_SYNTH();
+  TempDir dir;
+  write_text(dir / "p.yaml", two_chains_config(""));
+  const fs::path ws = dir / "ws";
+  auto r = run_tega({"run", (dir / "p.yaml").string(), "--jobs", "2"}, dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("4 shard(s) ran, 0 up to date"), std::string::npos) << r.output;
+
+  r = run_tega({"run", (dir / "p.yaml").string()}, dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("0 shard(s) ran, 4 up to date"), std::string::npos) << r.output;
+
+  write_text(dir / "p.yaml", two_chains_config("      noise_sigma: 0.01\n"));
+  EXPECT_EQ(shard_state(status_json(dir / "p.yaml", dir.path()), "synth_b", "default"), "stale");
+  EXPECT_EQ(shard_state(status_json(dir / "p.yaml", dir.path()), "check_b", "default"), "stale");
+  EXPECT_EQ(shard_state(status_json(dir / "p.yaml", dir.path()), "synth_a", "default"), "done");
+  r = run_tega({"run", (dir / "p.yaml").string()}, dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("2 shard(s) ran, 2 up to date"), std::string::npos) << r.output;
+  EXPECT_EQ(attempts(ws, "synth_a", "default"), 1);
+  EXPECT_EQ(attempts(ws, "check_a", "default"), 1);
+  EXPECT_EQ(attempts(ws, "synth_b", "default"), 2);
+  EXPECT_EQ(attempts(ws, "check_b", "default"), 2);
+  EXPECT_NE(read_text_file(ws / "synth_b/default/options.yaml").find("noise_sigma: 0.01"), std::string::npos);
+}
+
+TEST(TegaRun, ASubjectsOwnOptionsReRunOnlyThatSubject) {
+  REQUIRE_SYNTH();
+  TempDir dir;
+  write_text(dir / "p.yaml", two_subjects_config("seed: 2"));
+  ASSERT_EQ(run_tega({"run", (dir / "p.yaml").string()}, dir.path()).exit_code, 0);
+  write_text(dir / "p.yaml", two_subjects_config("seed: 3"));
+  const auto r = run_tega({"run", (dir / "p.yaml").string()}, dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(attempts(dir / "ws", "synth", "alice"), 1);
+  EXPECT_EQ(attempts(dir / "ws", "check", "alice"), 1);
+  EXPECT_EQ(attempts(dir / "ws", "synth", "bob"), 2);
+  EXPECT_EQ(attempts(dir / "ws", "check", "bob"), 2);
+}
+
+TEST(TegaRun, ForceFromAndOnlySelectWhatRuns) {
+  REQUIRE_SYNTH();
+  TempDir dir;
+  write_text(dir / "p.yaml", two_subjects_config("seed: 2"));
+  const std::string config = (dir / "p.yaml").string();
+  const fs::path ws = dir / "ws";
+
+  // --only check before synth is done: nothing runs, and the reason is named.
+  auto r = run_tega({"run", config, "--only", "check"}, dir.path());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("synth/alice blocked: is not up to date and its stage is not selected"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("check/alice blocked: needs synth/alice, which is blocked"), std::string::npos) << r.output;
+  EXPECT_EQ(attempts(ws, "synth", "alice"), 0);
+
+  ASSERT_EQ(run_tega({"run", config, "--only", "synth"}, dir.path()).exit_code, 0);
+  EXPECT_EQ(attempts(ws, "check", "alice"), 0);
+  ASSERT_EQ(run_tega({"run", config, "--only", "check"}, dir.path()).exit_code, 0);
+  EXPECT_EQ(attempts(ws, "check", "alice"), 1);
+
+  // --force synth re-runs synth; its outputs are identical (deterministic), so check stays done.
+  const auto before = committed_outputs(ws);
+  r = run_tega({"run", config, "--force", "synth"}, dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(attempts(ws, "synth", "alice"), 2);
+  EXPECT_EQ(attempts(ws, "check", "alice"), 1);
+  EXPECT_EQ(committed_outputs(ws), before);
+
+  // --from synth re-runs synth and everything downstream.
+  ASSERT_EQ(run_tega({"run", config, "--from", "synth"}, dir.path()).exit_code, 0);
+  EXPECT_EQ(attempts(ws, "synth", "bob"), 3);
+  EXPECT_EQ(attempts(ws, "check", "bob"), 2);
+
+  r = run_tega({"run", config, "--only", "chek"}, dir.path());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("has no stage 'chek'; its stages: synth, check"), std::string::npos) << r.output;
+}
+
+TEST(TegaRun, AMissingInputFailsItsShardOnlyAndStatusNamesTheError) {
+  REQUIRE_SYNTH();
+  TempDir dir;
+  write_text(dir / "p.yaml", two_subjects_config("head: no-such-head"));
+  const auto r = run_tega({"run", (dir / "p.yaml").string()}, dir.path());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("synth/bob failed: " + (dir / "no-such-head").string() + ": does not exist"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("check/bob blocked: needs synth/bob, which failed"), std::string::npos) << r.output;
+
+  const json status = status_json(dir / "ws", dir.path());
+  EXPECT_EQ(shard_state(status, "synth", "alice"), "done");
+  EXPECT_EQ(shard_state(status, "check", "alice"), "done");
+  EXPECT_EQ(shard_state(status, "synth", "bob"), "failed");
+  EXPECT_NE(status["stages"][0]["shards"][1]["reason"].get<std::string>().find("no-such-head: does not exist"),
+            std::string::npos);
+  EXPECT_EQ(status["stages"][0]["shards"][1]["log"], (dir / "ws/logs/synth/bob.log").string());
+  EXPECT_EQ(shard_state(status, "check", "bob"), "pending");
+}
+
+TEST(TegaRun, ACorruptCommittedInputFailsTheShardThatReadsItAndLeavesCompletedShardsIntact) {
+  REQUIRE_SYNTH();
+  TempDir dir;
+  write_text(dir / "p.yaml", two_subjects_config("seed: 2"));
+  const std::string config = (dir / "p.yaml").string();
+  const fs::path ws = dir / "ws";
+  ASSERT_EQ(run_tega({"run", config}, dir.path()).exit_code, 0);
+  const std::string synth_manifest = read_text_file(ws / "synth/alice/manifest.json");
+
+  // Same size, garbage content: the manifest's cheap size check cannot see it; the reader must.
+  const fs::path image = ws / "synth/alice/capture/dataset/images/cam00/expressions_000000.png";
+  const auto size = fs::file_size(image);
+  write_text(image, std::string(size, 'x'));
+  auto r = run_tega({"run", config, "--force", "check"}, dir.path());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("check/alice failed: exit code 1: tega: error: " + image.string()), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("(log: " + (ws / "logs/check/alice.log").string() + ")"), std::string::npos) << r.output;
+  EXPECT_EQ(read_text_file(ws / "synth/alice/manifest.json"), synth_manifest);
+  EXPECT_EQ(attempts(ws, "check", "bob"), 2);
+  const json status = status_json(ws, dir.path());
+  EXPECT_EQ(shard_state(status, "check", "alice"), "failed");
+  EXPECT_EQ(shard_state(status, "check", "bob"), "done");
+  EXPECT_EQ(shard_state(status, "synth", "alice"), "done");
+
+  // A missing output file makes its shard stale, and the next run makes it again.
+  fs::remove(image);
+  EXPECT_EQ(shard_state(status_json(ws, dir.path()), "synth", "alice"), "stale");
+  r = run_tega({"run", config}, dir.path());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(image));
+  EXPECT_EQ(attempts(ws, "synth", "alice"), 2);
+  EXPECT_EQ(shard_state(status_json(ws, dir.path()), "check", "alice"), "done");
+}
+
+TEST(TegaRun, CtrlCStopsCleanlyAndTheNextRunFinishes) {
+  REQUIRE_SYNTH();
+  TempDir dir;
+  // One slow shard (a few seconds) to interrupt.
+  write_text(dir / "p.yaml",
+             "workspace: ws\nstages:\n  synth:\n    options:\n      studio: {cameras: 2, width: 96, height: 72}\n"
+             "      frames: 4\n      calibration_frames: 1\n      write_fine_meshes: false\n      threads: 1\n");
+  const std::string config = (dir / "p.yaml").string();
+  const fs::path ws = dir / "ws";
+  const pid_t run = spawn_tega({"run", config}, dir / "interrupted.txt");
+  ASSERT_GT(run, 0);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (!fs::exists(ws / "synth/default.state.json") && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+
+  // A second run on the same workspace is refused while the first holds it.
+  const auto second = run_tega({"run", config}, dir.path());
+  EXPECT_EQ(second.exit_code, 1);
+  EXPECT_NE(second.output.find("another `tega run` is using this workspace"), std::string::npos) << second.output;
+
+  ::kill(run, SIGINT);
+  EXPECT_EQ(wait_for_exit(run), 130);
+  const std::string output = read_text_file(dir / "interrupted.txt");
+  EXPECT_NE(output.find("interrupted; run it again"), std::string::npos) << output;
+  EXPECT_FALSE(process_mentions(ws.string()));
+  EXPECT_FALSE(fs::exists(ws / "synth/default/manifest.json"));
+  EXPECT_EQ(shard_state(status_json(ws, dir.path()), "synth", "default"), "interrupted");
+
+  const auto resumed = run_tega({"run", config}, dir.path());
+  EXPECT_EQ(resumed.exit_code, 0) << resumed.output;
+  EXPECT_EQ(shard_state(status_json(ws, dir.path()), "synth", "default"), "done");
+  EXPECT_TRUE(staging_dirs(ws).empty());
+}
+
+TEST(TegaRun, StagesThatDoNotExistYetAreReportedNotFaked) {
+  TempDir dir;
+  const fs::path config = fs::path(TEGA_STUDIO_CONFIGS) / "studio13-capture.yaml";
+  const auto r = run_tega({"run", config.string(), "--workspace", (dir / "ws").string()}, dir.path());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  for (const char* stage : {"capture", "calibrate", "mvs", "tracking", "matting"}) {
+    EXPECT_NE(r.output.find(std::string(stage) + "/default unavailable: not implemented in tega yet"), std::string::npos)
+        << stage << "\n"
+        << r.output;
+  }
+  EXPECT_NE(r.output.find("0 shard(s) ran"), std::string::npos) << r.output;
+  const json status = status_json(dir / "ws", dir.path());
+  for (const auto& stage : status["stages"]) {
+    if (stage["kind"] == "train") {
+      EXPECT_EQ(stage["shards"][0]["state"], stage["available"] ? "pending" : "unavailable");
+    } else if (stage["kind"] != "eval" && stage["kind"] != "render") {
+      EXPECT_FALSE(stage["available"]) << stage;
+      EXPECT_EQ(stage["shards"][0]["state"], "unavailable");
+    }
+  }
+}
+
+TEST(TegaRun, TheShippedConfigsAreValidGraphs) {
+  for (const char* name : {"demo.yaml", "studio13-capture.yaml"}) {
+    TempDir dir;
+    const auto r = run_tega({"status", (fs::path(TEGA_STUDIO_CONFIGS) / name).string(), "--json"}, dir.path());
+    EXPECT_EQ(r.exit_code, 0) << name << ": " << r.output;
+  }
+}
+
+}  // namespace
+}  // namespace tega::test
