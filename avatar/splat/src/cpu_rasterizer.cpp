@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <utility>
 
 namespace tega::splat::cpu {
 namespace {
@@ -47,21 +48,27 @@ std::vector<int32_t> bin(const RasterInputs<T>& in, const ProjectedBuffers<T>& p
     if (ca != cb) return ca < cb;
     return projected.splats[a].depth < projected.splats[b].depth;
   });
-  // Counting sort by tile keeps the depth order inside each tile.
+  // Each Gaussian's tiles: those of its rectangle that its ellipse may
+  // touch (the same test as the CUDA path). A counting sort by tile keeps the
+  // depth order inside each tile.
   const ImageGeometry& g = in.geometry;
   const int64_t tiles_per_camera = int64_t(g.tiles_x) * g.tiles_y;
-  std::vector<int64_t> counts(in.num_tiles() + 1, 0);
-  auto for_each_tile = [&](int32_t id, auto&& visit) {
+  std::vector<std::pair<int64_t, int32_t>> entries;  // (tile, id), in depth order
+  for (int32_t id : order) {
     const TileRect& r = projected.rects[id];
+    const Splat2D<T>& sp = projected.splats[id];
+    const T level = splat_level(sp);
     const int64_t base = (id / n) * tiles_per_camera;
     for (int32_t ty = r.y0; ty < r.y1; ++ty)
-      for (int32_t tx = r.x0; tx < r.x1; ++tx) visit(base + int64_t(ty) * g.tiles_x + tx);
-  };
-  for (int32_t id : order) for_each_tile(id, [&](int64_t tile) { ++counts[tile + 1]; });
+      for (int32_t tx = r.x0; tx < r.x1; ++tx)
+        if (splat_may_touch_tile(sp, level, g, tx, ty)) entries.emplace_back(base + int64_t(ty) * g.tiles_x + tx, id);
+  }
+  std::vector<int64_t> counts(in.num_tiles() + 1, 0);
+  for (const auto& [tile, id] : entries) ++counts[tile + 1];
   std::partial_sum(counts.begin(), counts.end(), counts.begin());
   std::vector<int32_t> ids(counts.back());
   std::vector<int64_t> cursor(counts.begin(), counts.end() - 1);
-  for (int32_t id : order) for_each_tile(id, [&](int64_t tile) { ids[cursor[tile]++] = id; });
+  for (const auto& [tile, id] : entries) ids[cursor[tile]++] = id;
   for (int64_t t = 0; t < in.num_tiles(); ++t) {
     ranges[2 * t] = int32_t(counts[t]);
     ranges[2 * t + 1] = int32_t(counts[t + 1]);

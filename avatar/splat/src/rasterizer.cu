@@ -20,8 +20,14 @@ void check(cudaError_t status, const char* what) {
 #define TEGA_CHECK_LAUNCH(kernel) check(cudaGetLastError(), "launching " #kernel)
 
 constexpr int kThreads = 256;
-constexpr int kPixelsPerTile = kTileSize * kTileSize;
-static_assert(kPixelsPerTile == kThreads, "one thread per pixel of a tile");
+// The blending kernels give each thread two pixels of a tile, so that a
+// splat read from shared memory and each warp reduction serve 64 pixels.
+constexpr int kRenderThreads = 128;
+constexpr int kWarpRows = 4;  // a warp covers a 16 x 4 block of its tile
+static_assert(kTileSize * kTileSize == 2 * kRenderThreads, "two pixels per thread");
+static_assert(kTileSize * kWarpRows == 64 && kTileSize * kTileSize / 64 == kRenderThreads / 32,
+              "warps of 64 pixels tile the tile");
+constexpr int kProjectBackwardThreads = 64;
 constexpr unsigned kFullWarp = 0xffffffffu;
 
 unsigned grid_for(int64_t n) { return unsigned((n + kThreads - 1) / kThreads); }
@@ -62,44 +68,60 @@ __global__ void tile_counts_kernel(int64_t count, const int32_t* ids, const Tile
   if (i < count) counts[i] = rects[ids[i]].count();
 }
 
-__global__ void emit_intersections_kernel(RasterInputs<float> in, const TileRect* rects, DepthOrder order,
-                                          uint32_t* tile_keys, int32_t* gaussian_ids) {
+// Writes each Gaussian's slots: the key of each tile of its rectangle that
+// its ellipse may touch, or `culled` (past every tile: sorted to the end and
+// never read) for the others.
+__global__ void emit_intersections_kernel(RasterInputs<float> in, const Splat2D<float>* splats, const TileRect* rects,
+                                          DepthOrder order, uint32_t* tile_keys, int32_t* gaussian_ids) {
   const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
   if (i >= in.num_projected()) return;
   const int32_t id = order.ids[i];
   const TileRect r = rects[id];
+  if (r.count() == 0) return;
   int64_t slot = order.tile_offsets[i] - r.count();
   const ImageGeometry g = in.geometry;
   const uint32_t base = uint32_t(id / in.num_gaussians) * uint32_t(g.tiles_x * g.tiles_y);
+  const uint32_t culled = uint32_t(in.num_tiles());
+  const Splat2D<float> sp = splats[id];
+  const float level = splat_level(sp);
   for (int32_t ty = r.y0; ty < r.y1; ++ty)
     for (int32_t tx = r.x0; tx < r.x1; ++tx, ++slot) {
-      tile_keys[slot] = base + uint32_t(ty * g.tiles_x + tx);
+      tile_keys[slot] = splat_may_touch_tile(sp, level, g, tx, ty) ? base + uint32_t(ty * g.tiles_x + tx) : culled;
       gaussian_ids[slot] = id;
     }
 }
 
-__global__ void tile_ranges_kernel(int64_t count, const uint32_t* sorted_keys, int32_t* ranges) {
+__global__ void tile_ranges_kernel(int64_t count, uint32_t culled, const uint32_t* sorted_keys, int32_t* ranges) {
   const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
   if (i >= count) return;
   const uint32_t key = sorted_keys[i];
+  if (key == culled) return;
   if (i == 0 || sorted_keys[i - 1] != key) ranges[2 * int64_t(key)] = int32_t(i);
   if (i == count - 1 || sorted_keys[i + 1] != key) ranges[2 * int64_t(key) + 1] = int32_t(i + 1);
 }
 
-struct TilePixel {
-  int64_t tile, pixel;
-  int32_t px, py;
-  bool inside;
+// A thread's two pixels: column lane % 16, rows 4w + lane / 16 and two
+// below, for warp w.
+struct TilePixels {
+  int64_t tile;
+  int64_t pixel[2];
+  float px, py[2];
+  bool inside[2];
 };
 
-__device__ TilePixel tile_pixel(const ImageGeometry& g) {
-  TilePixel t;
+__device__ TilePixels tile_pixels(const ImageGeometry& g) {
+  TilePixels t;
   const int32_t camera = blockIdx.z;
+  const int32_t lane = int32_t(threadIdx.x % 32), warp = int32_t(threadIdx.x / 32);
   t.tile = (int64_t(camera) * g.tiles_y + blockIdx.y) * g.tiles_x + blockIdx.x;
-  t.px = int32_t(blockIdx.x) * kTileSize + int32_t(threadIdx.x % kTileSize);
-  t.py = int32_t(blockIdx.y) * kTileSize + int32_t(threadIdx.x / kTileSize);
-  t.inside = t.px < g.width && t.py < g.height;
-  t.pixel = (int64_t(camera) * g.height + t.py) * g.width + t.px;
+  const int32_t x = int32_t(blockIdx.x) * kTileSize + lane % kTileSize;
+  t.px = float(x);
+  for (int k = 0; k < 2; ++k) {
+    const int32_t y = int32_t(blockIdx.y) * kTileSize + kWarpRows * warp + lane / kTileSize + 2 * k;
+    t.py[k] = float(y);
+    t.inside[k] = x < g.width && y < g.height;
+    t.pixel[k] = (int64_t(camera) * g.height + y) * g.width + x;
+  }
   return t;
 }
 
@@ -112,93 +134,121 @@ __device__ __forceinline__ void copy_splat(Splat2D<float>& dst, const Splat2D<fl
   d[2] = s[2];
 }
 
-__global__ void __launch_bounds__(kThreads) render_forward_kernel(RasterInputs<float> in,
-                                                                  const Splat2D<float>* splats, TileBins bins,
-                                                                  ImageBuffers<float> image) {
-  __shared__ Splat2D<float> batch[kThreads];
+__global__ void __launch_bounds__(kRenderThreads) render_forward_kernel(RasterInputs<float> in,
+                                                                        const Splat2D<float>* splats, TileBins bins,
+                                                                        ImageBuffers<float> image) {
+  __shared__ Splat2D<float> batch[kRenderThreads];
   const ImageGeometry g = in.geometry;
-  const TilePixel tp = tile_pixel(g);
+  const TilePixels tp = tile_pixels(g);
   const int32_t begin = bins.ranges[2 * tp.tile], end = bins.ranges[2 * tp.tile + 1];
-  PixelAccumulator<float> acc;
-  acc.done = !tp.inside;
-  const float px = float(tp.px), py = float(tp.py);
-  for (int32_t start = begin; start < end; start += kThreads) {
+  PixelAccumulator<float> acc[2];
+  acc[0].done = !tp.inside[0];
+  acc[1].done = !tp.inside[1];
+  for (int32_t start = begin; start < end; start += kRenderThreads) {
     // Also the barrier that lets this round overwrite the previous batch.
-    if (__syncthreads_count(acc.done) == kThreads) break;
+    if (__syncthreads_count(acc[0].done && acc[1].done) == kRenderThreads) break;
     const int32_t k = start + int32_t(threadIdx.x);
     if (k < end) copy_splat(batch[threadIdx.x], splats[bins.gaussian_ids[k]]);
     __syncthreads();
-    const int32_t count = min(kThreads, end - start);
-    for (int32_t j = 0; j < count && !acc.done; ++j) blend_forward(acc, batch[j], px, py, start - begin + j);
+    const int32_t count = min(kRenderThreads, end - start);
+    for (int32_t j = 0; j < count && !(acc[0].done && acc[1].done); ++j) {
+      Splat2D<float> sp;
+      copy_splat(sp, batch[j]);
+      const int32_t index = start - begin + j;
+      if (!acc[0].done) blend_forward(acc[0], sp, tp.px, tp.py[0], index);
+      if (!acc[1].done) blend_forward(acc[1], sp, tp.px, tp.py[1], index);
+    }
   }
-  if (!tp.inside) return;
   const float* bg = in.background;
-  for (int ch = 0; ch < 3; ++ch) image.rgb[3 * tp.pixel + ch] = acc.rgb[ch] + acc.transmittance * bg[ch];
-  image.alpha[tp.pixel] = 1.0f - acc.transmittance;
-  image.depth[tp.pixel] = acc.depth;
-  image.final_transmittance[tp.pixel] = acc.transmittance;
-  image.last[tp.pixel] = acc.last;
+  for (int p = 0; p < 2; ++p) {
+    if (!tp.inside[p]) continue;
+    const int64_t pixel = tp.pixel[p];
+    const PixelAccumulator<float>& a = acc[p];
+    for (int ch = 0; ch < 3; ++ch) image.rgb[3 * pixel + ch] = a.rgb[ch] + a.transmittance * bg[ch];
+    image.alpha[pixel] = 1.0f - a.transmittance;
+    image.depth[pixel] = a.depth;
+    image.final_transmittance[pixel] = a.transmittance;
+    image.last[pixel] = a.last;
+  }
 }
 
-__device__ __forceinline__ float warp_sum(float value) {
-  for (int offset = 16; offset > 0; offset /= 2) value += __shfl_down_sync(kFullWarp, value, offset);
-  return value;
+// Sums the ten gradient fields of a splat over the warp by recursive
+// halving: at each step a lane keeps half of the values it carries and
+// swaps the other half with its partner, 12 shuffles in all (a shuffle tree
+// per field takes 50). On return `total` holds the warp's sum of field
+// number `field` (u, v, opacity, depth, conic a, b, c, red, green, blue);
+// field is -1 where the lane holds none. Lanes 2i and 2i + 1 hold the same.
+__device__ __forceinline__ int warp_reduce_scatter(const Splat2D<float>& grad, float& total) {
+  const unsigned lane = threadIdx.x % 32;
+  const float v[10] = {grad.u,       grad.v,       grad.opacity, grad.depth, grad.conic_a,
+                       grad.conic_b, grad.conic_c, grad.red,     grad.green, grad.blue};
+  const bool h16 = lane & 16, h8 = lane & 8, h4 = lane & 4, h2 = lane & 2;
+  float a[5];  // fields 5·h16 + i
+#pragma unroll
+  for (int i = 0; i < 5; ++i) {
+    const float send = h16 ? v[i] : v[i + 5], keep = h16 ? v[i + 5] : v[i];
+    a[i] = keep + __shfl_xor_sync(kFullWarp, send, 16);
+  }
+  float b[3];  // entries 3·h8 + i of a (the sixth is empty)
+#pragma unroll
+  for (int i = 0; i < 3; ++i) {
+    const float upper = i + 3 < 5 ? a[i + 3] : 0.0f;
+    const float send = h8 ? a[i] : upper, keep = h8 ? upper : a[i];
+    b[i] = keep + __shfl_xor_sync(kFullWarp, send, 8);
+  }
+  float c[2];  // entries 2·h4 + i of b (the fourth is empty)
+#pragma unroll
+  for (int i = 0; i < 2; ++i) {
+    const float upper = i + 2 < 3 ? b[i + 2] : 0.0f;
+    const float send = h4 ? b[i] : upper, keep = h4 ? upper : b[i];
+    c[i] = keep + __shfl_xor_sync(kFullWarp, send, 4);
+  }
+  const float send = h2 ? c[0] : c[1], keep = h2 ? c[1] : c[0];
+  total = keep + __shfl_xor_sync(kFullWarp, send, 2);
+  total += __shfl_xor_sync(kFullWarp, total, 1);
+  const int index_b = (h4 ? 2 : 0) + (h2 ? 1 : 0);
+  const int index_a = (h8 ? 3 : 0) + index_b;
+  return index_b < 3 && index_a < 5 ? (h16 ? 5 : 0) + index_a : -1;
 }
 
-__device__ __forceinline__ void atomic_add_splat(Splat2D<float>& dst, const Splat2D<float>& v) {
-#if defined(__CUDA_ARCH__) && __CUDA_ARCH__ >= 900
-  float4* d = reinterpret_cast<float4*>(&dst);
-  atomicAdd(d, make_float4(v.u, v.v, v.opacity, v.depth));
-  atomicAdd(d + 1, make_float4(v.conic_a, v.conic_b, v.conic_c, 0.0f));
-  atomicAdd(d + 2, make_float4(v.red, v.green, v.blue, 0.0f));
-#else
-  atomicAdd(&dst.u, v.u);
-  atomicAdd(&dst.v, v.v);
-  atomicAdd(&dst.opacity, v.opacity);
-  atomicAdd(&dst.depth, v.depth);
-  atomicAdd(&dst.conic_a, v.conic_a);
-  atomicAdd(&dst.conic_b, v.conic_b);
-  atomicAdd(&dst.conic_c, v.conic_c);
-  atomicAdd(&dst.red, v.red);
-  atomicAdd(&dst.green, v.green);
-  atomicAdd(&dst.blue, v.blue);
-#endif
-}
+// Offset of gradient field number `field` (warp_reduce_scatter's order) in a Splat2D.
+__device__ __forceinline__ int splat_field_offset(int field) { return field < 7 ? field : field + 1; }
 
-__global__ void __launch_bounds__(kThreads) render_backward_kernel(RasterInputs<float> in,
-                                                                   const Splat2D<float>* splats, TileBins bins,
-                                                                   ImageBuffers<float> image,
-                                                                   ImageGradients<float> grads,
-                                                                   Splat2D<float>* splat_grads) {
-  __shared__ Splat2D<float> batch[kThreads];
-  __shared__ int32_t batch_ids[kThreads];
+__global__ void __launch_bounds__(kRenderThreads) render_backward_kernel(RasterInputs<float> in,
+                                                                         const Splat2D<float>* splats, TileBins bins,
+                                                                         ImageBuffers<float> image,
+                                                                         ImageGradients<float> grads,
+                                                                         Splat2D<float>* splat_grads) {
+  __shared__ Splat2D<float> batch[kRenderThreads];
+  __shared__ int32_t batch_ids[kRenderThreads];
   __shared__ int32_t block_last;
   const ImageGeometry g = in.geometry;
-  const TilePixel tp = tile_pixel(g);
+  const TilePixels tp = tile_pixels(g);
   const int32_t begin = bins.ranges[2 * tp.tile];
   const float* bg = in.background;
 
-  PixelBackward<float> st;
-  int32_t last = 0;
-  if (tp.inside) {
-    for (int ch = 0; ch < 3; ++ch) st.grad_rgb[ch] = grads.rgb[3 * tp.pixel + ch];
-    st.grad_alpha_out = grads.alpha[tp.pixel];
-    st.grad_depth = grads.depth[tp.pixel];
-    st.final_transmittance = image.final_transmittance[tp.pixel];
-    st.transmittance = st.final_transmittance;
-    st.background_dot = bg[0] * st.grad_rgb[0] + bg[1] * st.grad_rgb[1] + bg[2] * st.grad_rgb[2];
-    last = image.last[tp.pixel];
+  PixelBackward<float> st[2];
+  int32_t last[2] = {0, 0};
+  for (int p = 0; p < 2; ++p) {
+    if (!tp.inside[p]) continue;
+    const int64_t pixel = tp.pixel[p];
+    for (int ch = 0; ch < 3; ++ch) st[p].grad_rgb[ch] = grads.rgb[3 * pixel + ch];
+    st[p].grad_alpha_out = grads.alpha[pixel];
+    st[p].grad_depth = grads.depth[pixel];
+    st[p].final_transmittance = image.final_transmittance[pixel];
+    st[p].transmittance = st[p].final_transmittance;
+    st[p].background_dot = bg[0] * st[p].grad_rgb[0] + bg[1] * st[p].grad_rgb[1] + bg[2] * st[p].grad_rgb[2];
+    last[p] = image.last[pixel];
   }
+  const int32_t warp_last = __reduce_max_sync(kFullWarp, unsigned(max(last[0], last[1])));
   if (threadIdx.x == 0) block_last = 0;
   __syncthreads();
-  atomicMax(&block_last, last);
+  if (threadIdx.x % 32 == 0) atomicMax(&block_last, warp_last);
   __syncthreads();
-  const float px = float(tp.px), py = float(tp.py);
-  const int32_t lane = int32_t(threadIdx.x % 32);
 
   // Back to front, in batches loaded from the end of the tile's run.
-  for (int32_t stop = begin + block_last; stop > begin; stop -= kThreads) {
-    const int32_t start = max(begin, stop - kThreads);
+  for (int32_t stop = begin + block_last; stop > begin; stop -= kRenderThreads) {
+    const int32_t start = max(begin, stop - kRenderThreads);
     __syncthreads();
     const int32_t k = stop - 1 - int32_t(threadIdx.x);
     if (k >= start) {
@@ -208,31 +258,64 @@ __global__ void __launch_bounds__(kThreads) render_backward_kernel(RasterInputs<
     }
     __syncthreads();
     const int32_t count = stop - start;
-    for (int32_t j = 0; j < count; ++j) {
+    // batch[j] is entry stop - 1 - j - begin of the tile; the warp's pixels
+    // blended only entries below warp_last.
+    for (int32_t j = max(0, stop - begin - warp_last); j < count; ++j) {
       const int32_t index_in_tile = stop - 1 - j - begin;
+      Splat2D<float> sp;
+      copy_splat(sp, batch[j]);
       Splat2D<float> local{};
       bool contributed = false;
-      if (index_in_tile < last) contributed = blend_backward(st, batch[j], px, py, local);
+      if (index_in_tile < last[0]) contributed |= blend_backward(st[0], sp, tp.px, tp.py[0], local);
+      if (index_in_tile < last[1]) contributed |= blend_backward(st[1], sp, tp.px, tp.py[1], local);
       if (!__any_sync(kFullWarp, contributed)) continue;
-      local.u = warp_sum(local.u);
-      local.v = warp_sum(local.v);
-      local.opacity = warp_sum(local.opacity);
-      local.depth = warp_sum(local.depth);
-      local.conic_a = warp_sum(local.conic_a);
-      local.conic_b = warp_sum(local.conic_b);
-      local.conic_c = warp_sum(local.conic_c);
-      local.red = warp_sum(local.red);
-      local.green = warp_sum(local.green);
-      local.blue = warp_sum(local.blue);
-      if (lane == 0) atomic_add_splat(splat_grads[batch_ids[j]], local);
+      float total;
+      const int field = warp_reduce_scatter(local, total);
+      if (field >= 0 && (threadIdx.x & 1) == 0)
+        atomicAdd(reinterpret_cast<float*>(&splat_grads[batch_ids[j]]) + splat_field_offset(field), total);
     }
   }
 }
 
-__global__ void project_backward_kernel(RasterInputs<float> in, const int32_t* radii,
-                                        const Splat2D<float>* splat_grads, InputGradients<float> out) {
-  const int64_t g = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
-  if (g < in.num_gaussians) project_backward_one(in, radii, splat_grads, g, out);
+// One thread per Gaussian. SH rows (3K floats per Gaussian) are staged
+// through shared memory, read and written by the block with coalesced
+// accesses; each thread's row has an odd stride, free of bank conflicts.
+__global__ void __launch_bounds__(kProjectBackwardThreads)
+    project_backward_kernel(RasterInputs<float> in, const int32_t* radii, const Splat2D<float>* splat_grads,
+                            InputGradients<float> out) {
+  extern __shared__ float sh_stage[];
+  const int64_t first = int64_t(blockIdx.x) * blockDim.x;
+  const int64_t g = first + threadIdx.x;
+  const int64_t n = in.num_gaussians;
+  if (in.sh_coefficients == 0) {
+    if (g < n) project_backward_one(in, radii, splat_grads, g, out);
+    return;
+  }
+  const int32_t width = 3 * in.sh_coefficients, stride = width | 1;
+  float* sh = sh_stage;
+  float* grad_sh = sh_stage + blockDim.x * stride;
+  const int32_t elements = int32_t(min(int64_t(blockDim.x), n - first)) * width;
+  // Element k of the block's rows is (row k / width, column k % width);
+  // threads step by blockDim.x elements.
+  const int32_t step_row = int32_t(blockDim.x) / width, step_col = int32_t(blockDim.x) % width;
+  const float* src = in.colors + first * width;
+  for (int32_t k = threadIdx.x, row = k / width, col = k % width; k < elements; k += blockDim.x) {
+    sh[row * stride + col] = src[k];
+    row += step_row;
+    col += step_col;
+    if (col >= width) col -= width, ++row;
+  }
+  __syncthreads();
+  if (g < n) project_backward_one(in, radii, splat_grads, g, out, sh + threadIdx.x * stride,
+                                  grad_sh + threadIdx.x * stride);
+  __syncthreads();
+  float* dst = out.colors + first * width;
+  for (int32_t k = threadIdx.x, row = k / width, col = k % width; k < elements; k += blockDim.x) {
+    dst[k] = grad_sh[row * stride + col];
+    row += step_row;
+    col += step_col;
+    if (col >= width) col -= width, ++row;
+  }
 }
 
 }  // namespace
@@ -288,20 +371,21 @@ void bin(const RasterInputs<float>& in, const ProjectedBuffers<float>& projected
   if (total > INT_MAX) throw std::runtime_error("tega splat: more than 2^31 tile-Gaussian intersections");
   auto* keys = static_cast<uint32_t*>(workspace.allocate(2 * total * sizeof(uint32_t)));
   auto* unsorted_ids = static_cast<int32_t*>(workspace.allocate(total * sizeof(int32_t)));
-  emit_intersections_kernel<<<grid_for(in.num_projected()), kThreads, 0, stream>>>(in, projected.rects, order, keys,
+  emit_intersections_kernel<<<grid_for(in.num_projected()), kThreads, 0, stream>>>(in, projected.splats,
+                                                                                  projected.rects, order, keys,
                                                                                   unsorted_ids);
   TEGA_CHECK_LAUNCH(emit_intersections_kernel);
 
   // Stable, so the depth order survives inside each tile; only the tile
-  // bits are sorted.
-  const int end_bit = bits_for(num_tiles);
+  // bits (and the culled key, num_tiles) are sorted.
+  const int end_bit = bits_for(num_tiles + 1);
   std::size_t sort_bytes = 0;
   TEGA_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, sort_bytes, keys, keys + total, unsorted_ids,
                                                   gaussian_ids, int(total), 0, end_bit, stream));
   void* sort_temp = workspace.allocate(sort_bytes);
   TEGA_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(sort_temp, sort_bytes, keys, keys + total, unsorted_ids,
                                                   gaussian_ids, int(total), 0, end_bit, stream));
-  tile_ranges_kernel<<<grid_for(total), kThreads, 0, stream>>>(total, keys + total, ranges);
+  tile_ranges_kernel<<<grid_for(total), kThreads, 0, stream>>>(total, uint32_t(num_tiles), keys + total, ranges);
   TEGA_CHECK_LAUNCH(tile_ranges_kernel);
 }
 
@@ -309,7 +393,7 @@ void render_forward(const RasterInputs<float>& in, const Splat2D<float>* splats,
                     const ImageBuffers<float>& image, cudaStream_t stream) {
   if (in.num_pixels() == 0) return;
   const dim3 grid(in.geometry.tiles_x, in.geometry.tiles_y, in.num_cameras);
-  render_forward_kernel<<<grid, kThreads, 0, stream>>>(in, splats, bins, image);
+  render_forward_kernel<<<grid, kRenderThreads, 0, stream>>>(in, splats, bins, image);
   TEGA_CHECK_LAUNCH(render_forward_kernel);
 }
 
@@ -318,14 +402,17 @@ void render_backward(const RasterInputs<float>& in, const Splat2D<float>* splats
                      Splat2D<float>* splat_grads, cudaStream_t stream) {
   if (in.num_pixels() == 0) return;
   const dim3 grid(in.geometry.tiles_x, in.geometry.tiles_y, in.num_cameras);
-  render_backward_kernel<<<grid, kThreads, 0, stream>>>(in, splats, bins, image, grads, splat_grads);
+  render_backward_kernel<<<grid, kRenderThreads, 0, stream>>>(in, splats, bins, image, grads, splat_grads);
   TEGA_CHECK_LAUNCH(render_backward_kernel);
 }
 
 void project_backward(const RasterInputs<float>& in, const int32_t* radii, const Splat2D<float>* splat_grads,
                       const InputGradients<float>& out, cudaStream_t stream) {
   if (in.num_gaussians == 0) return;
-  project_backward_kernel<<<grid_for(in.num_gaussians), kThreads, 0, stream>>>(in, radii, splat_grads, out);
+  const int64_t blocks = (in.num_gaussians + kProjectBackwardThreads - 1) / kProjectBackwardThreads;
+  const std::size_t stage_bytes = 2 * kProjectBackwardThreads * std::size_t(3 * in.sh_coefficients | 1) * sizeof(float);
+  project_backward_kernel<<<unsigned(blocks), kProjectBackwardThreads, in.sh_coefficients > 0 ? stage_bytes : 0,
+                            stream>>>(in, radii, splat_grads, out);
   TEGA_CHECK_LAUNCH(project_backward_kernel);
 }
 

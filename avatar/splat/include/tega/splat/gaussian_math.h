@@ -341,6 +341,12 @@ TEGA_HD bool project_covariance(const CameraParams<T>& cam, const ImageGeometry&
   return true;
 }
 
+// The level of q = dᵀ conic d at which opacity·G falls to kMinAlpha.
+template <typename T>
+TEGA_HD T splat_level(const Splat2D<T>& sp) {
+  return T(2) * math_log(sp.opacity / T(kMinAlpha));
+}
+
 // Half-extents (px) of the ellipse where opacity·G ≥ kMinAlpha, and the
 // tiles it touches. Returns the radius reported to callers (0 when culled).
 template <typename T>
@@ -348,7 +354,7 @@ TEGA_HD int32_t splat_footprint(const Splat2D<T>& sp, const ProjectionState<T>& 
                                 TileRect& rect) {
   rect = {0, 0, 0, 0};
   if (!(sp.opacity >= T(kMinAlpha))) return 0;
-  const T level = T(2) * math_log(sp.opacity / T(kMinAlpha));  // q = dᵀ conic d at alpha = kMinAlpha
+  const T level = splat_level(sp);
   const T low_pass = T(kLowPassVariance);
   // A small margin keeps pixels whose alpha rounds to the threshold inside.
   const T ext_x = math_sqrt(level * (st.s00 + low_pass)) + T(0.01);
@@ -361,6 +367,42 @@ TEGA_HD int32_t splat_footprint(const Splat2D<T>& sp, const ProjectionState<T>& 
   rect.y0 = int32_t(py0) / kTileSize;
   rect.y1 = int32_t(py1) / kTileSize + 1;
   return int32_t(math_ceil(math_max(ext_x, ext_y)));
+}
+
+// False only when every point of the pixel-centre rectangle [x0, x1] × [y0,
+// y1] lies outside the ellipse q ≤ level, so the blending skips the splat at
+// every pixel there (alpha < kMinAlpha). The minimum of the convex q over the
+// continuous rectangle is exact; the margin covers rounding in q, which grows
+// with the size of its terms over the rectangle.
+template <typename T>
+TEGA_HD bool splat_may_touch(const Splat2D<T>& sp, T level, T x0, T y0, T x1, T y1) {
+  const T dx0 = x0 - sp.u, dx1 = x1 - sp.u, dy0 = y0 - sp.v, dy1 = y1 - sp.v;
+  if (dx0 <= T(0) && dx1 >= T(0) && dy0 <= T(0) && dy1 >= T(0)) return true;
+  const T a = sp.conic_a, b = sp.conic_b, c = sp.conic_c;
+  // With the centre outside, the minimum of q = a dx² + 2b dx dy + c dy²
+  // lies on an edge: on x = const at dy = -b dx / c (clamped), and so on.
+  T q_min = T(0);
+  for (int e = 0; e < 4; ++e) {
+    const bool vertical = e < 2;
+    const T fixed = vertical ? (e == 0 ? dx0 : dx1) : (e == 2 ? dy0 : dy1);
+    const T lo = vertical ? dy0 : dx0, hi = vertical ? dy1 : dx1;
+    const T along_curv = vertical ? c : a, fixed_curv = vertical ? a : c;
+    const T along = math_min(math_max(-b * fixed / along_curv, lo), hi);
+    const T q = fixed_curv * fixed * fixed + (T(2) * b * fixed + along_curv * along) * along;
+    q_min = e == 0 ? q : math_min(q_min, q);
+  }
+  const T mx = math_max(-dx0, dx1), my = math_max(-dy0, dy1);
+  const T magnitude = a * mx * mx + T(2) * (b < T(0) ? -b : b) * mx * my + c * my * my;
+  return q_min <= level * T(1.001) + T(0.01) + T(1e-5) * magnitude;
+}
+
+// splat_may_touch for tile (tx, ty): its pixel centres inside the image.
+template <typename T>
+TEGA_HD bool splat_may_touch_tile(const Splat2D<T>& sp, T level, const ImageGeometry& g, int32_t tx, int32_t ty) {
+  const int32_t x0 = tx * kTileSize, y0 = ty * kTileSize;
+  const int32_t x1 = x0 + kTileSize - 1 < g.width - 1 ? x0 + kTileSize - 1 : g.width - 1;
+  const int32_t y1 = y0 + kTileSize - 1 < g.height - 1 ? y0 + kTileSize - 1 : g.height - 1;
+  return splat_may_touch(sp, level, T(x0), T(y0), T(x1), T(y1));
 }
 
 // Projects one Gaussian: its splat (colour excluded), tile rectangle and
@@ -534,7 +576,8 @@ TEGA_HD bool blend_backward(PixelBackward<T>& st, const Splat2D<T>& sp, T px, T 
   const T alpha = math_min(T(kMaxAlpha), raw_alpha);
   if (alpha < T(kMinAlpha)) return false;
   const T one_minus = T(1) - alpha;
-  st.transmittance = st.transmittance / one_minus;  // T before this splat
+  const T inv_one_minus = T(1) / one_minus;
+  st.transmittance = st.transmittance * inv_one_minus;  // T before this splat
   const T t = st.transmittance;
   const T w = alpha * t;
   grad.red += w * st.grad_rgb[0];
@@ -546,7 +589,7 @@ TEGA_HD bool blend_backward(PixelBackward<T>& st, const Splat2D<T>& sp, T px, T 
   for (int ch = 0; ch < 3; ++ch) grad_a += (colour[ch] - st.behind_rgb[ch]) * st.grad_rgb[ch];
   grad_a += (sp.depth - st.behind_depth) * st.grad_depth;
   grad_a *= t;
-  const T final_over = st.final_transmittance / one_minus;
+  const T final_over = st.final_transmittance * inv_one_minus;
   grad_a += final_over * (st.grad_alpha_out - st.background_dot);
   for (int ch = 0; ch < 3; ++ch) st.behind_rgb[ch] = alpha * colour[ch] + one_minus * st.behind_rgb[ch];
   st.behind_depth = alpha * sp.depth + one_minus * st.behind_depth;
