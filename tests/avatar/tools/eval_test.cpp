@@ -1,0 +1,144 @@
+#include <ATen/ATen.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "tega/core/error.h"
+#include "tega/core/files.h"
+#include "tega/core/image.h"
+#include "tega/tools/evaluate.h"
+#include "tega/tools/landmarks.h"
+#include "tega/tools/metrics.h"
+#include "tega/trainer/render.h"
+#include "tiny_avatar.h"
+
+namespace {
+
+using namespace tega;
+using namespace tega::tools;
+
+at::Tensor dataset_image(const Dataset& d, const std::string& camera, const std::string& frame) {
+  Image8 image = read_image_u8(d.image_path(camera, frame));
+  return at::from_blob(image.pixels.data(), {image.height, image.width, image.channels}, at::kByte).clone();
+}
+
+TEST(Eval, ScoresTheViewsOfThePapersProtocol) {
+  test::TinyAvatar tiny;
+  const std::vector<SplitResult> splits = evaluate_avatar(*tiny.avatar, tiny.dataset, "test", nullptr);
+  ASSERT_EQ(splits.size(), 2u);
+  // Reenactment: the test frame from the training camera; novel view: the
+  // training frame from the test camera.
+  ASSERT_EQ(splits[0].name, "reenactment");
+  ASSERT_EQ(splits[0].views.size(), 1u);
+  EXPECT_EQ(splits[0].views[0].frame, "blink_000000");
+  EXPECT_EQ(splits[0].views[0].camera, "cam00");
+  ASSERT_EQ(splits[1].name, "novel_view");
+  ASSERT_EQ(splits[1].views.size(), 1u);
+  EXPECT_EQ(splits[1].views[0].frame, "smile_000000");
+  EXPECT_EQ(splits[1].views[0].camera, "cam01");
+
+  // Each view is scored against its own image (the tiny dataset's images
+  // differ per camera and frame).
+  const at::Tensor background = at::tensor(tiny.avatar->options.background, at::kFloat);
+  for (const SplitResult& split : splits) {
+    const ViewResult& v = split.views[0];
+    at::NoGradGuard no_grad;
+    const trainer::FrameInput input = tiny.model().frame_input(tiny.dataset.load_mesh(v.frame), tiny.dataset.frame(v.frame).head_to_world);
+    const at::Tensor rendered = trainer::render_view(tiny.model(), input, tiny.dataset.rig.camera(v.camera), tiny.avatar->phase,
+                                                     background, false)
+                                    .clamp(0, 1);
+    const at::Tensor target = trainer::composite_target(dataset_image(tiny.dataset, v.camera, v.frame), background);
+    EXPECT_NEAR(v.metrics.at("psnr"), psnr(rendered, target), 1e-9);
+    EXPECT_NEAR(v.metrics.at("l1"), l1(rendered, target), 1e-9);
+    EXPECT_NEAR(v.metrics.at("ssim"), ssim(rendered, target), 1e-9);
+    // The tiny dataset's matte is opaque everywhere: masked = full.
+    EXPECT_NEAR(v.metrics.at("psnr_masked"), v.metrics.at("psnr"), 1e-9);
+    EXPECT_EQ(v.metrics.count("lpips"), 0u);
+    EXPECT_EQ(v.metrics.count("landmark_px"), 0u);
+  }
+}
+
+TEST(Eval, LandmarksFollowTheDeformationField) {
+  test::TinyAvatar tiny;
+  tiny.dataset.landmark_vertices = {0, 1, 2};
+  const LandmarkProbe probe(tiny.dataset, at::kCPU);
+  const Vertices vertices = tiny.dataset.load_mesh("blink_000000");
+  const trainer::FrameInput input = tiny.model().frame_input(vertices, tiny.dataset.frame("blink_000000").head_to_world);
+  const Camera& camera = tiny.dataset.rig.camera("cam00");
+  // Without the field the avatar's landmarks are the tracked vertices.
+  const at::Tensor rigid = probe.avatar(tiny.model(), input, {false, true, 3});
+  EXPECT_TRUE(at::allclose(rigid, probe.reference(vertices), 1e-6, 1e-6));
+  EXPECT_NEAR(landmark_error_px(probe.reference(vertices), rigid, camera), 0.0, 1e-4);
+  // With it, they move by the field's displacement, projected.
+  const at::Tensor moved = probe.avatar(tiny.model(), input, {true, true, 3});
+  const double error = landmark_error_px(probe.reference(vertices), moved, camera);
+  EXPECT_GT(error, 1e-3);
+  double expected = 0;
+  for (int l = 0; l < 3; ++l) {
+    const auto p = camera.project(Eigen::Vector3d(vertices(l, 0), vertices(l, 1), vertices(l, 2)));
+    const auto q = camera.project(Eigen::Vector3d(moved[l][0].item<double>(), moved[l][1].item<double>(), moved[l][2].item<double>()));
+    ASSERT_TRUE(p && q) << "landmark " << l << " must be in front of the camera";
+    expected += (*p - *q).norm() / 3;
+  }
+  EXPECT_NEAR(error, expected, 1e-9);
+
+  const std::vector<SplitResult> splits = evaluate_avatar(*tiny.avatar, tiny.dataset, "test", nullptr);
+  EXPECT_NEAR(splits[0].views[0].metrics.at("landmark_px"), landmark_error_px(probe.reference(vertices), moved, camera), 1e-6);
+}
+
+TEST(Eval, JsonAndMarkdownHoldStatisticsNotesAndInfinity) {
+  test::TinyAvatar tiny;
+  ModelResult model{"Ours", tiny.tmp / "run", 6, 300, evaluate_avatar(*tiny.avatar, tiny.dataset, "test", nullptr)};
+  // A second model whose reenactment renders are perfect: PSNR = inf.
+  ModelResult perfect = model;
+  perfect.name = "Perfect";
+  for (auto& v : perfect.splits[0].views) {
+    v.metrics["psnr"] = std::numeric_limits<double>::infinity();
+    v.metrics["ssim"] = 1.0;
+    v.metrics["l1"] = 0.0;
+  }
+  const EvalNotes notes = evaluation_notes(tiny.dataset, false);
+  write_evaluation({model, perfect}, notes, tiny.tmp / "eval/out.json");
+
+  const auto doc = nlohmann::json::parse(read_text_file(tiny.tmp / "eval/out.json"));
+  EXPECT_NE(doc["notes"]["lpips"].get<std::string>().find("skipped"), std::string::npos);
+  EXPECT_NE(doc["notes"]["landmarks"].get<std::string>().find("skipped"), std::string::npos);
+  ASSERT_EQ(doc["models"].size(), 2u);
+  const auto& ours = doc["models"][0]["splits"];
+  const double psnr_value = model.splits[0].views[0].metrics.at("psnr");
+  EXPECT_NEAR(ours["reenactment"]["metrics"]["psnr"]["mean"].get<double>(), psnr_value, 1e-9);
+  EXPECT_EQ(ours["reenactment"]["metrics"]["psnr"]["std"].get<double>(), 0.0);
+  EXPECT_EQ(ours["reenactment"]["metrics"]["psnr"]["count"].get<int>(), 1);
+  EXPECT_NEAR(ours["reenactment"]["per_camera"]["cam00"]["metrics"]["psnr"]["mean"].get<double>(), psnr_value, 1e-9);
+  EXPECT_NEAR(ours["reenactment"]["per_frame"]["blink_000000"]["metrics"]["psnr"]["mean"].get<double>(), psnr_value, 1e-9);
+  EXPECT_TRUE(ours["novel_view"]["per_camera"].contains("cam01"));
+  EXPECT_EQ(ours["novel_view"]["per_view"][0]["frame"], "smile_000000");
+  EXPECT_FALSE(ours["reenactment"]["metrics"].contains("lpips"));
+  const auto& perfect_json = doc["models"][1]["splits"]["reenactment"]["metrics"];
+  EXPECT_EQ(perfect_json["psnr"]["mean"], "inf");
+  EXPECT_EQ(perfect_json["psnr"]["std"], "nan");
+  EXPECT_EQ(perfect_json["ssim"]["mean"].get<double>(), 1.0);
+
+  const std::string markdown = read_text_file(tiny.tmp / "eval/out.md");
+  EXPECT_NE(markdown.find("| Ours |"), std::string::npos) << markdown;
+  EXPECT_NE(markdown.find("| Perfect |"), std::string::npos) << markdown;
+  EXPECT_NE(markdown.find("Test reenactment PSNR ↑"), std::string::npos) << markdown;
+  EXPECT_NE(markdown.find("Novel view SSIM ↑"), std::string::npos) << markdown;
+  EXPECT_NE(markdown.find("∞ ± nan"), std::string::npos) << markdown;
+  char psnr_text[32];
+  std::snprintf(psnr_text, sizeof psnr_text, "%.2f ± 0.00", psnr_value);
+  EXPECT_NE(markdown.find(psnr_text), std::string::npos) << markdown;
+  EXPECT_NE(markdown.find("LPIPS skipped"), std::string::npos) << markdown;
+}
+
+TEST(Eval, TrainSplitAndUnknownSplits) {
+  test::TinyAvatar tiny;
+  const auto train = evaluation_views(tiny.dataset, "train");
+  ASSERT_EQ(train.size(), 1u);
+  EXPECT_EQ(train[0].views.size(), 1u);
+  EXPECT_EQ(train[0].views[0].camera, "cam00");
+  EXPECT_THROW(evaluation_views(tiny.dataset, "validation"), Error);
+}
+
+}  // namespace
