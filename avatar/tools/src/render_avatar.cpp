@@ -180,8 +180,10 @@ RenderSummary render_avatar(trainer::TrainedAvatar& avatar, const Dataset& datas
       const fs::path truth = dataset.image_path(camera.name, frame.id);
       if (job.side_by_side && rc.from_dataset && frame.from_dataset && fs::exists(truth)) {
         at::Tensor target = trainer::composite_target(detail::read_rgba(truth).to(device), background);
-        if (target.size(1) != camera.height || target.size(2) != camera.width)
-          target = at::upsample_bilinear2d(target.unsqueeze(0), {camera.height, camera.width}, false).squeeze(0);
+        if (target.size(1) != camera.height || target.size(2) != camera.width) {
+          const std::vector<int64_t> size{camera.height, camera.width};
+          target = at::upsample_bilinear2d(target.unsqueeze(0), size, /*align_corners=*/false).squeeze(0);
+        }
         fs::create_directories(staged.path() / "side_by_side" / camera.name);
         write_image(detail::to_image(at::cat({rgb, target}, 2)),
                     staged.path() / "side_by_side" / camera.name / (frame.id + ".png"));

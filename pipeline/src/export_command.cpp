@@ -1,0 +1,82 @@
+#include <iostream>
+#include <memory>
+
+#include "commands.h"
+#include "tega/core/error.h"
+#include "tega/core/files.h"
+#include "tega/core/progress.h"
+#include "tega/tools/export.h"
+#include "tega/tools/load_run.h"
+#include "tega/tools/render_avatar.h"
+
+namespace tega::cli {
+
+namespace {
+struct ExportArguments {
+  std::string model, data, out, meshes, mesh_pose, device;
+  std::vector<std::string> frames;
+  bool head_space = false, force = false;
+};
+}  // namespace
+
+void add_export_command(CLI::App& app) {
+  auto args = std::make_shared<ExportArguments>();
+  auto* cmd = app.add_subcommand("export", "Export posed Gaussians as 3D Gaussian Splatting PLY files for splat viewers "
+                                           "(docs/render-eval-export.md).");
+  cmd->add_option("--model", args->model, "Training run directory (RUN of tega train).")->required();
+  cmd->add_option("--out", args->out,
+                  "One frame: the .ply file. Several frames (or --meshes): a directory of <frame>.ply.")
+      ->required();
+  cmd->add_option("--frame", args->frames, "Dataset frame id(s), comma-separated; 'all' for every frame.")->delimiter(',');
+  cmd->add_option("--meshes", args->meshes,
+                  "Export a directory of meshes (.bin/.obj/.ply, template topology, world space) instead of dataset frames.");
+  cmd->add_option("--mesh-pose", args->mesh_pose, "Dataset frame whose head pose the --meshes take (default: the first training frame).");
+  cmd->add_flag("--head-space", args->head_space, "The --meshes are in head space: move them by the --mesh-pose pose first.");
+  cmd->add_option("--data", args->data, "Dataset directory (default: the one RUN/run.json names).");
+  cmd->add_option("--device", args->device, "cpu or cuda (default: the run's device).");
+  cmd->add_flag("--force", args->force, "Replace an existing output directory (a single .ply is always replaced atomically).");
+  cmd->callback([args] {
+    if (args->frames.empty() == args->meshes.empty()) throw Error("tega export: give --frame or --meshes (one of them)");
+    tools::LoadedRun run = tools::load_run(args->model, args->data, args->device);
+    const Dataset& dataset = run.dataset;
+    std::vector<tools::RenderFrame> frames;
+    if (!args->meshes.empty()) {
+      const std::string pose_frame = args->mesh_pose.empty() ? dataset.train.frames.at(0) : args->mesh_pose;
+      frames = tools::mesh_sequence(args->meshes, dataset.template_mesh.num_vertices(),
+                                    dataset.frame(pose_frame).head_to_world, args->head_space);
+    } else {
+      std::vector<std::string> ids = args->frames;
+      if (ids == std::vector<std::string>{"all"}) {
+        ids.clear();
+        for (const auto& f : dataset.frames) ids.push_back(f.id);
+      }
+      frames = tools::dataset_frames(dataset, ids);
+    }
+
+    trainer::TrainedAvatar& avatar = *run.avatar;
+    const auto cloud = [&](const tools::RenderFrame& f) {
+      return tools::export_frame(avatar.model, avatar.model.frame_input(f.world_vertices, f.head_to_world), avatar.phase);
+    };
+    const std::filesystem::path out = args->out;
+    if (frames.size() == 1 && args->meshes.empty() && out.extension() == ".ply") {
+      tools::write_gaussian_ply(cloud(frames.front()), out);
+      std::cout << "wrote " << avatar.model.gaussians.size() << " Gaussians of frame " << frames.front().id << " to "
+                << out.string() << "\n";
+      return;
+    }
+    if (out.extension() == ".ply")
+      throw Error(out, "several frames go to a directory of <frame>.ply files: give --out a directory name");
+    StagedDirectory staged(out, args->force);
+    Progress progress("export", static_cast<int64_t>(frames.size()), "frames");
+    for (const auto& f : frames) {
+      tools::write_gaussian_ply(cloud(f), staged.path() / (f.id + ".ply"));
+      progress.advance();
+    }
+    progress.finish();
+    staged.commit();
+    std::cout << "wrote " << frames.size() << " PLY files of " << avatar.model.gaussians.size() << " Gaussians to "
+              << out.string() << "\n";
+  });
+}
+
+}  // namespace tega::cli
