@@ -20,14 +20,14 @@ void check(cudaError_t status, const char* what) {
 #define TEGA_CHECK_LAUNCH(kernel) check(cudaGetLastError(), "launching " #kernel)
 
 constexpr int kThreads = 256;
-// The blending kernels give each thread two pixels of a tile, so that a
+static_assert(kTileSize * kTileSize == kThreads, "forward blending: one thread per pixel of a tile");
+// The backward blending gives each thread two pixels of a tile, so that a
 // splat read from shared memory and each warp reduction serve 64 pixels.
 constexpr int kRenderThreads = 128;
 constexpr int kWarpRows = 4;  // a warp covers a 16 x 4 block of its tile
 static_assert(kTileSize * kTileSize == 2 * kRenderThreads, "two pixels per thread");
 static_assert(kTileSize * kWarpRows == 64 && kTileSize * kTileSize / 64 == kRenderThreads / 32,
               "warps of 64 pixels tile the tile");
-constexpr int kProjectBackwardThreads = 64;
 constexpr unsigned kFullWarp = 0xffffffffu;
 
 unsigned grid_for(int64_t n) { return unsigned((n + kThreads - 1) / kThreads); }
@@ -100,6 +100,60 @@ __global__ void tile_ranges_kernel(int64_t count, uint32_t culled, const uint32_
   if (i == count - 1 || sorted_keys[i + 1] != key) ranges[2 * int64_t(key) + 1] = int32_t(i + 1);
 }
 
+struct TilePixel {
+  int64_t tile, pixel;
+  int32_t px, py;
+  bool inside;
+};
+
+__device__ TilePixel tile_pixel(const ImageGeometry& g) {
+  TilePixel t;
+  const int32_t camera = blockIdx.z;
+  t.tile = (int64_t(camera) * g.tiles_y + blockIdx.y) * g.tiles_x + blockIdx.x;
+  t.px = int32_t(blockIdx.x) * kTileSize + int32_t(threadIdx.x % kTileSize);
+  t.py = int32_t(blockIdx.y) * kTileSize + int32_t(threadIdx.x / kTileSize);
+  t.inside = t.px < g.width && t.py < g.height;
+  t.pixel = (int64_t(camera) * g.height + t.py) * g.width + t.px;
+  return t;
+}
+
+// Copies a splat with three 16-byte loads.
+__device__ __forceinline__ void copy_splat(Splat2D<float>& dst, const Splat2D<float>& src) {
+  const float4* s = reinterpret_cast<const float4*>(&src);
+  float4* d = reinterpret_cast<float4*>(&dst);
+  d[0] = s[0];
+  d[1] = s[1];
+  d[2] = s[2];
+}
+
+__global__ void __launch_bounds__(kThreads) render_forward_kernel(RasterInputs<float> in,
+                                                                  const Splat2D<float>* splats, TileBins bins,
+                                                                  ImageBuffers<float> image) {
+  __shared__ Splat2D<float> batch[kThreads];
+  const ImageGeometry g = in.geometry;
+  const TilePixel tp = tile_pixel(g);
+  const int32_t begin = bins.ranges[2 * tp.tile], end = bins.ranges[2 * tp.tile + 1];
+  PixelAccumulator<float> acc;
+  acc.done = !tp.inside;
+  const float px = float(tp.px), py = float(tp.py);
+  for (int32_t start = begin; start < end; start += kThreads) {
+    // Also the barrier that lets this round overwrite the previous batch.
+    if (__syncthreads_count(acc.done) == kThreads) break;
+    const int32_t k = start + int32_t(threadIdx.x);
+    if (k < end) copy_splat(batch[threadIdx.x], splats[bins.gaussian_ids[k]]);
+    __syncthreads();
+    const int32_t count = min(kThreads, end - start);
+    for (int32_t j = 0; j < count && !acc.done; ++j) blend_forward(acc, batch[j], px, py, start - begin + j);
+  }
+  if (!tp.inside) return;
+  const float* bg = in.background;
+  for (int ch = 0; ch < 3; ++ch) image.rgb[3 * tp.pixel + ch] = acc.rgb[ch] + acc.transmittance * bg[ch];
+  image.alpha[tp.pixel] = 1.0f - acc.transmittance;
+  image.depth[tp.pixel] = acc.depth;
+  image.final_transmittance[tp.pixel] = acc.transmittance;
+  image.last[tp.pixel] = acc.last;
+}
+
 // A thread's two pixels: column lane % 16, rows 4w + lane / 16 and two
 // below, for warp w.
 struct TilePixels {
@@ -123,53 +177,6 @@ __device__ TilePixels tile_pixels(const ImageGeometry& g) {
     t.pixel[k] = (int64_t(camera) * g.height + y) * g.width + x;
   }
   return t;
-}
-
-// Copies a splat with three 16-byte loads.
-__device__ __forceinline__ void copy_splat(Splat2D<float>& dst, const Splat2D<float>& src) {
-  const float4* s = reinterpret_cast<const float4*>(&src);
-  float4* d = reinterpret_cast<float4*>(&dst);
-  d[0] = s[0];
-  d[1] = s[1];
-  d[2] = s[2];
-}
-
-__global__ void __launch_bounds__(kRenderThreads) render_forward_kernel(RasterInputs<float> in,
-                                                                        const Splat2D<float>* splats, TileBins bins,
-                                                                        ImageBuffers<float> image) {
-  __shared__ Splat2D<float> batch[kRenderThreads];
-  const ImageGeometry g = in.geometry;
-  const TilePixels tp = tile_pixels(g);
-  const int32_t begin = bins.ranges[2 * tp.tile], end = bins.ranges[2 * tp.tile + 1];
-  PixelAccumulator<float> acc[2];
-  acc[0].done = !tp.inside[0];
-  acc[1].done = !tp.inside[1];
-  for (int32_t start = begin; start < end; start += kRenderThreads) {
-    // Also the barrier that lets this round overwrite the previous batch.
-    if (__syncthreads_count(acc[0].done && acc[1].done) == kRenderThreads) break;
-    const int32_t k = start + int32_t(threadIdx.x);
-    if (k < end) copy_splat(batch[threadIdx.x], splats[bins.gaussian_ids[k]]);
-    __syncthreads();
-    const int32_t count = min(kRenderThreads, end - start);
-    for (int32_t j = 0; j < count && !(acc[0].done && acc[1].done); ++j) {
-      Splat2D<float> sp;
-      copy_splat(sp, batch[j]);
-      const int32_t index = start - begin + j;
-      if (!acc[0].done) blend_forward(acc[0], sp, tp.px, tp.py[0], index);
-      if (!acc[1].done) blend_forward(acc[1], sp, tp.px, tp.py[1], index);
-    }
-  }
-  const float* bg = in.background;
-  for (int p = 0; p < 2; ++p) {
-    if (!tp.inside[p]) continue;
-    const int64_t pixel = tp.pixel[p];
-    const PixelAccumulator<float>& a = acc[p];
-    for (int ch = 0; ch < 3; ++ch) image.rgb[3 * pixel + ch] = a.rgb[ch] + a.transmittance * bg[ch];
-    image.alpha[pixel] = 1.0f - a.transmittance;
-    image.depth[pixel] = a.depth;
-    image.final_transmittance[pixel] = a.transmittance;
-    image.last[pixel] = a.last;
-  }
 }
 
 // Sums the ten gradient fields of a splat over the warp by recursive
@@ -277,45 +284,10 @@ __global__ void __launch_bounds__(kRenderThreads) render_backward_kernel(RasterI
   }
 }
 
-// One thread per Gaussian. SH rows (3K floats per Gaussian) are staged
-// through shared memory, read and written by the block with coalesced
-// accesses; each thread's row has an odd stride, free of bank conflicts.
-__global__ void __launch_bounds__(kProjectBackwardThreads)
-    project_backward_kernel(RasterInputs<float> in, const int32_t* radii, const Splat2D<float>* splat_grads,
-                            InputGradients<float> out) {
-  extern __shared__ float sh_stage[];
-  const int64_t first = int64_t(blockIdx.x) * blockDim.x;
-  const int64_t g = first + threadIdx.x;
-  const int64_t n = in.num_gaussians;
-  if (in.sh_coefficients == 0) {
-    if (g < n) project_backward_one(in, radii, splat_grads, g, out);
-    return;
-  }
-  const int32_t width = 3 * in.sh_coefficients, stride = width | 1;
-  float* sh = sh_stage;
-  float* grad_sh = sh_stage + blockDim.x * stride;
-  const int32_t elements = int32_t(min(int64_t(blockDim.x), n - first)) * width;
-  // Element k of the block's rows is (row k / width, column k % width);
-  // threads step by blockDim.x elements.
-  const int32_t step_row = int32_t(blockDim.x) / width, step_col = int32_t(blockDim.x) % width;
-  const float* src = in.colors + first * width;
-  for (int32_t k = threadIdx.x, row = k / width, col = k % width; k < elements; k += blockDim.x) {
-    sh[row * stride + col] = src[k];
-    row += step_row;
-    col += step_col;
-    if (col >= width) col -= width, ++row;
-  }
-  __syncthreads();
-  if (g < n) project_backward_one(in, radii, splat_grads, g, out, sh + threadIdx.x * stride,
-                                  grad_sh + threadIdx.x * stride);
-  __syncthreads();
-  float* dst = out.colors + first * width;
-  for (int32_t k = threadIdx.x, row = k / width, col = k % width; k < elements; k += blockDim.x) {
-    dst[k] = grad_sh[row * stride + col];
-    row += step_row;
-    col += step_col;
-    if (col >= width) col -= width, ++row;
-  }
+__global__ void project_backward_kernel(RasterInputs<float> in, const int32_t* radii,
+                                        const Splat2D<float>* splat_grads, InputGradients<float> out) {
+  const int64_t g = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (g < in.num_gaussians) project_backward_one(in, radii, splat_grads, g, out);
 }
 
 }  // namespace
@@ -393,7 +365,7 @@ void render_forward(const RasterInputs<float>& in, const Splat2D<float>* splats,
                     const ImageBuffers<float>& image, cudaStream_t stream) {
   if (in.num_pixels() == 0) return;
   const dim3 grid(in.geometry.tiles_x, in.geometry.tiles_y, in.num_cameras);
-  render_forward_kernel<<<grid, kRenderThreads, 0, stream>>>(in, splats, bins, image);
+  render_forward_kernel<<<grid, kThreads, 0, stream>>>(in, splats, bins, image);
   TEGA_CHECK_LAUNCH(render_forward_kernel);
 }
 
@@ -409,10 +381,7 @@ void render_backward(const RasterInputs<float>& in, const Splat2D<float>* splats
 void project_backward(const RasterInputs<float>& in, const int32_t* radii, const Splat2D<float>* splat_grads,
                       const InputGradients<float>& out, cudaStream_t stream) {
   if (in.num_gaussians == 0) return;
-  const int64_t blocks = (in.num_gaussians + kProjectBackwardThreads - 1) / kProjectBackwardThreads;
-  const std::size_t stage_bytes = 2 * kProjectBackwardThreads * std::size_t(3 * in.sh_coefficients | 1) * sizeof(float);
-  project_backward_kernel<<<unsigned(blocks), kProjectBackwardThreads, in.sh_coefficients > 0 ? stage_bytes : 0,
-                            stream>>>(in, radii, splat_grads, out);
+  project_backward_kernel<<<grid_for(in.num_gaussians), kThreads, 0, stream>>>(in, radii, splat_grads, out);
   TEGA_CHECK_LAUNCH(project_backward_kernel);
 }
 
