@@ -1,12 +1,12 @@
 // `tega rig convert`: a rig between tega's JSON, COLMAP text and Multiface KRT
 // (docs/rig-files.md).
-#include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <memory>
 #include <string>
 
+#include "tega/core/log.h"
 #include "tega/core/rig.h"
 
 namespace tega::cli {
@@ -52,7 +52,7 @@ void convert(const ConvertArgs& args, bool size_given) {
     case RigFormat::colmap: write_colmap_text(rig, args.out, args.colmap_metres_per_unit); break;
     case RigFormat::krt: write_krt(rig, args.out); break;
   }
-  spdlog::info("wrote {} cameras to {}", rig.cameras.size(), args.out.string());
+  logging::info("wrote %zu cameras to %s", rig.cameras.size(), args.out.c_str());
 }
 
 }  // namespace

@@ -4,7 +4,6 @@
 #include <ATen/core/grad_mode.h>
 #include <ATen/CPUGeneratorImpl.h>
 #include <ATen/Parallel.h>
-#include <spdlog/spdlog.h>
 
 #include <chrono>
 #include <cmath>
@@ -15,6 +14,7 @@
 
 #include "tega/core/error.h"
 #include "tega/core/files.h"
+#include "tega/core/log.h"
 #include "tega/core/options.h"
 #include "tega/core/progress.h"
 #include "tega/nn/losses.h"
@@ -104,7 +104,7 @@ class Run {
     if (!options_.loss.vgg_weights.empty()) {
       vgg_.emplace(nn::VggPerceptualLoss::load(options_.loss.vgg_weights).to(device_));
     } else {
-      spdlog::info("perceptual (VGG) loss: off (no loss.vgg_weights configured)");
+      logging::info("perceptual (VGG) loss: off (no loss.vgg_weights configured)");
     }
     background_ = at::tensor(options_.background, at::kFloat).to(device_);
 
@@ -118,9 +118,9 @@ class Run {
       stats_ = splat::MeanGradientStats::zeros(model_.gaussians.uvd);
       max_world_std_ = at::zeros({model_.gaussians.size()}, background_.options());
     }
-    spdlog::info("dataset {}: {} frames, {} cameras; {} training views, template {} vertices; {} Gaussians",
-                 dataset_dir.string(), dataset_.frames.size(), dataset_.rig.cameras.size(), train_views_.size(),
-                 dataset_.template_mesh.num_vertices(), model_.gaussians.size());
+    logging::info("dataset %s: %zu frames, %zu cameras; %zu training views, template %d vertices; %lld Gaussians",
+                  dataset_dir.c_str(), dataset_.frames.size(), dataset_.rig.cameras.size(), train_views_.size(),
+                  dataset_.template_mesh.num_vertices(), static_cast<long long>(model_.gaussians.size()));
   }
 
   TrainSummary train(int64_t stop_at) {
@@ -147,9 +147,10 @@ class Run {
         summary.final_loss = window_loss / window;
         summary.train_psnr = window_psnr / window;
         metrics_.push_back({iteration_, summary.final_loss, summary.train_psnr, model_.gaussians.size(), seconds});
-        spdlog::info("it {}/{}  loss {:.5f}  psnr {:.2f}  gaussians {}  {:.2f} it/s  ETA {}", iteration_,
-                     options_.iterations, summary.final_loss, summary.train_psnr, model_.gaussians.size(), rate,
-                     Progress::format_duration(static_cast<double>(options_.iterations - iteration_) / rate));
+        logging::info("it %lld/%lld  loss %.5f  psnr %.2f  gaussians %lld  %.2f it/s  ETA %s",
+                      static_cast<long long>(iteration_), static_cast<long long>(options_.iterations),
+                      summary.final_loss, summary.train_psnr, static_cast<long long>(model_.gaussians.size()), rate,
+                      Progress::format_duration(static_cast<double>(options_.iterations - iteration_) / rate).c_str());
         window_loss = window_psnr = 0;
         window = 0;
       }
@@ -165,7 +166,7 @@ class Run {
     if (profiler_.enabled()) {
       summary.milliseconds_per_step = profiler_.mean_milliseconds(iteration_ - first);
       for (const auto& [name, ms] : summary.milliseconds_per_step) {
-        spdlog::info("profile: {:>14} {:8.2f} ms/it", name, ms);
+        logging::info("profile: %18s %8.2f ms/it", name.c_str(), ms);
       }
     }
     return summary;
@@ -274,8 +275,9 @@ class Run {
       const double pixels_per_ndc = 0.5 * std::max(camera.width, camera.height);
       DensifyStats stats{stats_.grad_norm_sum * pixels_per_ndc, stats_.visible_count, max_world_std_};
       const DensifyResult r = densify(model_.gaussians, adam_, stats, d, model_.lookup(), generator_);
-      spdlog::debug("densify at {}: cloned {}, split {}, pruned {} -> {} Gaussians", it, r.cloned, r.split, r.pruned,
-                    model_.gaussians.size());
+      logging::debug("densify at %lld: cloned %lld, split %lld, pruned %lld -> %lld Gaussians",
+                     static_cast<long long>(it), static_cast<long long>(r.cloned), static_cast<long long>(r.split),
+                     static_cast<long long>(r.pruned), static_cast<long long>(model_.gaussians.size()));
       stats_ = splat::MeanGradientStats::zeros(model_.gaussians.uvd);
       max_world_std_ = at::zeros({model_.gaussians.size()}, background_.options());
     }
@@ -332,7 +334,7 @@ class Run {
     generator_.set_state(tensor("trainer.rng_state").cpu());
     iteration_ = saved_iteration_ = c.iteration();
     metrics_ = read_metrics(run_dir_ / kMetrics, iteration_);
-    spdlog::info("resumed {} at iteration {}", (run_dir_ / kCheckpoint).string(), iteration_);
+    logging::info("resumed %s at iteration %lld", (run_dir_ / kCheckpoint).c_str(), static_cast<long long>(iteration_));
   }
 
   double heldout_psnr() {
