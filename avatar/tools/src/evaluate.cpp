@@ -1,5 +1,6 @@
 #include "tega/tools/evaluate.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <optional>

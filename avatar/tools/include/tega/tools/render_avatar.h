@@ -12,7 +12,6 @@
 //   OUT/render.json                      what was rendered, and why a video is missing
 
 #include <filesystem>
-#include <optional>
 #include <string>
 #include <vector>
 
