@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "tega/core/files.h"
 #include "tega/core/error.h"
 #include "tega/core/log.h"
 #include "tega/core/options.h"
@@ -54,7 +55,7 @@ int main(int argc, char** argv) {
       tega::set_option(options, kv.substr(0, eq), kv.substr(eq + 1));
     }
     const auto run = std::filesystem::temp_directory_path() / "tega-train-bench";
-    std::filesystem::remove_all(run);
+    tega::remove_tree(run);
 
     // Warm-up slice (CUDA start-up, allocator growth), then the timed slice.
     tega::trainer::train(data, run, options, {.stop_at = 5});

@@ -1,5 +1,6 @@
 #include "tega/core/files.h"
 
+#include <ftw.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -30,6 +31,14 @@ std::string read_text_file(const fs::path& file) {
   std::ostringstream text;
   text << in.rdbuf();
   return text.str();
+}
+
+void remove_tree(const fs::path& path) {
+  const auto remove_entry = [](const char* entry, const struct stat*, int, struct FTW*) { return ::remove(entry); };
+  // Depth first (FTW_DEPTH) so that directories are empty when removed; links are not followed.
+  if (::nftw(path.c_str(), remove_entry, 16, FTW_DEPTH | FTW_PHYS) != 0 && ::access(path.c_str(), F_OK) == 0) {
+    throw Error(path, "could not be removed");
+  }
 }
 
 void write_file_atomic(const fs::path& file, const std::function<void(const fs::path& temp)>& write) {
@@ -67,8 +76,11 @@ StagedDirectory::StagedDirectory(fs::path final_path, bool replace_existing)
 
 StagedDirectory::~StagedDirectory() {
   if (committed_) return;
-  std::error_code ignored;
-  fs::remove_all(staging_, ignored);
+  try {
+    remove_tree(staging_);
+  } catch (const Error&) {
+    // A destructor must not throw; the next run's cleanup takes the leftover.
+  }
 }
 
 void StagedDirectory::commit() {
@@ -82,7 +94,7 @@ void StagedDirectory::commit() {
   }
   fs::rename(staging_, final_);
   committed_ = true;
-  if (!old.empty()) fs::remove_all(old);
+  if (!old.empty()) remove_tree(old);
 }
 
 }  // namespace tega

@@ -10,6 +10,9 @@ void add_dataset_command(CLI::App& app);
 void add_rig_command(CLI::App& app);
 void add_ingest_command(CLI::App& app);
 void add_train_command(CLI::App& app);
+void add_render_command(CLI::App& app);
+void add_eval_command(CLI::App& app);
+void add_export_command(CLI::App& app);
 void add_run_command(CLI::App& app);
 void add_status_command(CLI::App& app);
 }  // namespace tega::cli

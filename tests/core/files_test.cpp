@@ -74,6 +74,17 @@ TEST(Files, StagedDirectoryRefusesOrReplacesExisting) {
   EXPECT_EQ(entries_in(tmp.path()), 1u);
 }
 
+TEST(Files, RemoveTreeRemovesNestedDirectoriesAndToleratesMissingPaths) {
+  tega::test::TempDir tmp;
+  tega::write_text_atomic(tmp / "tree/a/b/c.txt", "c");
+  tega::write_text_atomic(tmp / "tree/d.txt", "d");
+  std::filesystem::create_symlink(tmp.path(), tmp / "tree/link-to-parent");  // must not be followed
+  tega::remove_tree(tmp / "tree");
+  EXPECT_FALSE(fs::exists(tmp / "tree"));
+  EXPECT_TRUE(fs::exists(tmp.path()));
+  EXPECT_NO_THROW(tega::remove_tree(tmp / "never-existed"));
+}
+
 TEST(Files, ReadingAMissingFileNamesIt) {
   try {
     tega::read_text_file("/no/such/file.json");

@@ -96,7 +96,7 @@ TEST(KillNine, ResumedRunsEqualAnUninterruptedRun) {
     ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
     EXPECT_EQ(committed_outputs(ws), reference);
     EXPECT_TRUE(staging_dirs(ws).empty());
-    fs::remove_all(ws);
+    tega::remove_tree(ws);
   }
   // The kills landed all over the run: before anything was committed, in the
   // middle, and while shards of each stage were running.

@@ -5,6 +5,8 @@
 #include <random>
 
 #include "tega/core/dataset.h"
+#include "tega/core/error.h"
+#include "tega/core/files.h"
 #include "tega/core/image.h"
 
 namespace tega::test {
@@ -32,8 +34,10 @@ TempDir::TempDir() {
 }
 
 TempDir::~TempDir() {
-  std::error_code ec;
-  std::filesystem::remove_all(path_, ec);
+  try {
+    remove_tree(path_);
+  } catch (const Error&) {
+  }
 }
 
 void write_text(const std::filesystem::path& file, const std::string& text) {

@@ -13,6 +13,7 @@
 #include "tega/core/image.h"
 #include "tega/core/mesh.h"
 #include "tega/core/rig.h"
+#include "tega/core/files.h"
 #include "tega/synth/virtual_studio.h"
 #include "test_support.h"
 
@@ -42,10 +43,7 @@ const fs::path& capture() {
   struct Rendered {
     fs::path dir = fs::temp_directory_path() / ("tega-synth-capture-" + std::to_string(::getpid()));
     Rendered() { render_virtual_studio(small_capture_options(), dir, true); }
-    ~Rendered() {
-      std::error_code ec;
-      fs::remove_all(dir, ec);
-    }
+    ~Rendered() { tega::remove_tree(dir); }
   };
   static const Rendered rendered;
   return rendered.dir;

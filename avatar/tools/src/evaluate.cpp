@@ -1,4 +1,5 @@
 #include "tega/tools/evaluate.h"
+#include <ATen/core/grad_mode.h>
 
 #include <algorithm>
 #include <cmath>

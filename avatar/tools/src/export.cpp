@@ -1,6 +1,7 @@
 #include "tega/tools/export.h"
 
 #include <ATen/Parallel.h>
+#include <ATen/core/grad_mode.h>
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>

@@ -1,4 +1,5 @@
 #include "tega/tools/landmarks.h"
+#include <ATen/core/grad_mode.h>
 
 #include <cmath>
 #include <limits>

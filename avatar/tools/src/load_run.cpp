@@ -1,12 +1,12 @@
 #include "tega/tools/load_run.h"
 
 #include <ATen/Context.h>
-#include <spdlog/spdlog.h>
 
 #include <nlohmann/json.hpp>
 
 #include "tega/core/error.h"
 #include "tega/core/files.h"
+#include "tega/core/log.h"
 #include "tega/core/options.h"
 
 namespace tega::tools {
@@ -32,7 +32,7 @@ LoadedRun load_run(const fs::path& run, const fs::path& data, const std::string&
     load_options(options, run / "options.yaml");
     name = options.device;
     if (name.rfind("cuda", 0) == 0 && !at::hasCUDA()) {
-      spdlog::warn("{} trained on {}, but this build has no CUDA: using the CPU", run.string(), name);
+      logging::warn("%s trained on %s, but this build has no CUDA: using the CPU", run.c_str(), name.c_str());
       name = "cpu";
     }
   }
@@ -46,8 +46,9 @@ LoadedRun load_run(const fs::path& run, const fs::path& data, const std::string&
   LoadedRun loaded;
   loaded.dataset = read_dataset(data.empty() ? run_dataset(run) : data);
   loaded.avatar = std::make_unique<trainer::TrainedAvatar>(trainer::load_avatar(run, loaded.dataset, dev));
-  spdlog::info("{}: iteration {}, {} Gaussians, on {}", run.string(), loaded.avatar->iteration,
-               loaded.avatar->model.gaussians.size(), dev.str());
+  logging::info("%s: iteration %lld, %lld Gaussians, on %s", run.c_str(),
+                static_cast<long long>(loaded.avatar->iteration),
+                static_cast<long long>(loaded.avatar->model.gaussians.size()), dev.str().c_str());
   return loaded;
 }
 

@@ -1,4 +1,5 @@
 #include "tega/tools/lpips.h"
+#include <ATen/core/grad_mode.h>
 
 #include <string>
 

@@ -1,4 +1,5 @@
 #include "tega/tools/render_avatar.h"
+#include <ATen/core/grad_mode.h>
 
 #include <algorithm>
 #include <cmath>

@@ -172,7 +172,7 @@ class Run {
     const Stage& stage = stage_of(s);
     const SubjectConfig& subject = config_.subjects[s.subject];
     const fs::path staging = ws_.staging_dir(stage.name(), subject.name);
-    fs::remove_all(staging);
+    remove_tree(staging);
     fs::create_directories(staging);
 
     ShardPaths paths;

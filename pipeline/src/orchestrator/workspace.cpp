@@ -47,7 +47,7 @@ void Workspace::remove_leftovers(const std::vector<std::string>& stages) const {
     if (!fs::is_directory(folder)) continue;
     for (const auto& entry : fs::directory_iterator(folder)) {
       const std::string name = entry.path().filename().string();
-      if (name.rfind(kStagingPrefix, 0) == 0 || name.rfind(kReplacedPrefix, 0) == 0) fs::remove_all(entry.path());
+      if (name.rfind(kStagingPrefix, 0) == 0 || name.rfind(kReplacedPrefix, 0) == 0) remove_tree(entry.path());
     }
   }
 }
@@ -56,11 +56,11 @@ void Workspace::commit(const std::string& stage, const std::string& shard) const
   const fs::path final_dir = shard_dir(stage, shard);
   const fs::path replaced = root_ / stage / (kReplacedPrefix + shard);
   if (fs::exists(final_dir)) {
-    fs::remove_all(replaced);
+    remove_tree(replaced);
     fs::rename(final_dir, replaced);
   }
   fs::rename(staging_dir(stage, shard), final_dir);
-  fs::remove_all(replaced);
+  remove_tree(replaced);
 }
 
 WorkspaceLock::WorkspaceLock(const fs::path& root) {

@@ -12,6 +12,12 @@ namespace tega {
 
 std::string read_text_file(const std::filesystem::path& file);  // throws tega::Error
 
+// Removes a file or a directory tree; a missing path is not an error.
+// Use this rather than std::filesystem::remove_all: libtorch 2.x exports its
+// own, broken copy of remove_all, which the dynamic linker may bind instead
+// of libstdc++'s in any binary linked with it.
+void remove_tree(const std::filesystem::path& path);
+
 // Calls write(temp_path), then renames temp_path onto `file`. On an exception
 // the temporary is removed and `file` is untouched.
 void write_file_atomic(const std::filesystem::path& file,
