@@ -227,7 +227,11 @@ class Run {
     profiler_.section("backward");
     adam_.zero_grad();
     loss.backward();
-    check_finite(loss, loaded);
+    // One device sync per step: loss, MSE and the NaN/Inf check together.
+    const at::Tensor values = at::stack({loss.detach().to(at::kDouble), mse.to(at::kDouble),
+                                         all_finite(loss).to(at::kDouble)}).cpu();
+    const double* v = values.data_ptr<double>();
+    if (v[2] == 0.0) report_non_finite(loaded);
 
     profiler_.section("optimizer");
     adam_.step();
@@ -240,15 +244,19 @@ class Run {
 
     profiler_.section("densification");
     densify_if_due(camera);
-    return {loss.item<double>(), mse.item<double>()};
+    return {v[0], v[1]};
   }
 
-  void check_finite(const at::Tensor& loss, const LoadedView& loaded) {
+  // Whether the loss and every gradient are finite, as a 0-d bool tensor on the device.
+  at::Tensor all_finite(const at::Tensor& loss) const {
     std::vector<at::Tensor> finite{at::isfinite(loss).all()};
     for (const auto& g : adam_.groups()) {
       if (g.parameter.grad().defined()) finite.push_back(at::isfinite(g.parameter.grad()).all());
     }
-    if (at::stack(finite).all().item<bool>()) return;
+    return at::stack(finite).all();
+  }
+
+  [[noreturn]] void report_non_finite(const LoadedView& loaded) const {
     throw Error("iteration " + std::to_string(iteration_ + 1) + ": the loss or a gradient is NaN/Inf (camera " +
                 dataset_.rig.cameras[loaded.view.camera].name + ", frame " + dataset_.frames[loaded.view.frame].id +
                 "); training stopped, the last checkpoint (iteration " + std::to_string(saved_iteration_) +
