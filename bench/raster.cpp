@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 #if defined(TEGA_TORCH_HAS_CUDA)
@@ -76,8 +77,8 @@ double median_ms(F&& run) {
   return 0.5 * (times[kRepeats / 2 - 1] + times[kRepeats / 2]);
 }
 
-Result measure(int64_t n, int width, int height) {
-  const Scene s = head_scene(n, width, height);
+// The camera: 1 m from the head, fx = fy = 2 * width, SH degree 3.
+std::pair<RasterCamera, RasterSettings> head_view(int width, int height) {
   RasterCamera camera;
   camera.translation = {0.0, 0.0, 1.0};
   camera.fx = camera.fy = 2.0 * width;
@@ -87,6 +88,12 @@ Result measure(int64_t n, int width, int height) {
   settings.width = width;
   settings.height = height;
   settings.sh_degree = 3;
+  return {camera, settings};
+}
+
+Result measure(int64_t n, int width, int height) {
+  const Scene s = head_scene(n, width, height);
+  const auto [camera, settings] = head_view(width, height);
   const std::vector<at::Tensor> inputs = {s.means, s.covariances, s.sh, s.opacities, s.background};
 
   auto forward = [&] {
@@ -119,14 +126,7 @@ Result measure(int64_t n, int width, int height) {
 // passes of one size, for a profiler (ncu) to time each kernel.
 int profile(int64_t n, int width, int height) {
   const Scene s = head_scene(n, width, height);
-  RasterCamera camera;
-  camera.translation = {0.0, 0.0, 1.0};
-  camera.fx = camera.fy = 2.0 * width;
-  camera.cx = 0.5 * width;
-  camera.cy = 0.5 * height;
-  RasterSettings settings;
-  settings.width = width;
-  settings.height = height;
+  const auto [camera, settings] = head_view(width, height);
   for (int i = 0; i < 2; ++i) {
     const RasterOutput out = rasterize(s.means, s.covariances, s.sh, s.opacities, s.background, {camera}, settings);
     const at::Tensor loss = (out.rgb - s.target).abs().mean();
