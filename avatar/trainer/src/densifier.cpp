@@ -16,17 +16,22 @@ void DensifyStats::reset(int64_t n, const at::Device& device) {
 
 namespace {
 
-// Rows [keep] of every parameter followed by `appended` rows; the moments follow.
+// Rows [keep] of every parameter followed by `appended` rows (none when
+// empty); the moments follow.
 void rebuild(Gaussians& g, Adam& adam, const at::Tensor& keep, const std::map<std::string, at::Tensor>& appended,
              const at::Tensor& appended_triangles) {
-  const int64_t added = appended.begin()->second.size(0);
+  const int64_t added = appended.empty() ? 0 : appended.begin()->second.size(0);
   for (const auto& name : Gaussians::parameter_names()) {
     at::Tensor& p = g.parameter(name);
-    at::Tensor next = at::cat({p.detach().index_select(0, keep), appended.at(name)}).requires_grad_(true);
+    const at::Tensor kept = p.detach().index_select(0, keep);
+    at::Tensor next = (added > 0 ? at::cat({kept, appended.at(name)}) : kept).requires_grad_(true);
     adam.replace_rows(name, next, keep, added);
     p = next;
   }
-  if (g.bound_triangle.defined()) g.bound_triangle = at::cat({g.bound_triangle.index_select(0, keep), appended_triangles});
+  if (g.bound_triangle.defined()) {
+    const at::Tensor kept = g.bound_triangle.index_select(0, keep);
+    g.bound_triangle = added > 0 ? at::cat({kept, appended_triangles}) : kept;
+  }
 }
 
 }  // namespace
@@ -59,7 +64,8 @@ DensifyResult densify(Gaussians& g, Adam& adam, const DensifyStats& stats, const
   const at::Tensor parents = split_ids.repeat({2});
   const at::Tensor rotation = uvd::rotation_from_quaternion(g.rotation.index_select(0, parents));
   const at::Tensor scale = g.log_scale.index_select(0, parents).exp();
-  const at::Tensor z = at::randn({parents.size(0), 3, 1}, generator, g.uvd.options());
+  // The run's generator is a CPU one (runs reproduce on the CPU), so the noise is drawn there.
+  const at::Tensor z = at::randn({parents.size(0), 3, 1}, generator, g.uvd.options().device(at::kCPU)).to(g.uvd.device());
   at::Tensor child_uvd = g.uvd.index_select(0, parents) + rotation.bmm(scale.unsqueeze(2) * z).squeeze(2);
   if (!g.bound_triangle.defined() && child_uvd.size(0) > 0) {
     child_uvd = at::cat({lookup.project_to_valid_uv(child_uvd.slice(1, 0, 2)), child_uvd.slice(1, 2, 3)}, 1);
@@ -79,6 +85,8 @@ DensifyResult densify(Gaussians& g, Adam& adam, const DensifyStats& stats, const
   }
   const at::Tensor keep = split.logical_or(prune).logical_not().nonzero().flatten();
   rebuild(g, adam, keep, appended, appended_triangles);
+  // The new rows went to the end: back into uv_order (see gaussians.h).
+  rebuild(g, adam, uv_order(g.uvd), {}, {});
 
   DensifyResult r;
   r.cloned = clone_ids.size(0);

@@ -34,11 +34,19 @@ std::map<std::string, at::Tensor> Gaussians::tensors() const {
   return t;
 }
 
+at::Tensor uv_order(const at::Tensor& uv) {
+  constexpr int64_t kCells = 256;
+  const at::Tensor cell = (uv.slice(1, 0, 2).detach() * kCells).floor().clamp(0, kCells - 1).to(at::kLong);
+  const at::Tensor key = (kCells - 1 - cell.select(1, 1)) * kCells + cell.select(1, 0);  // top row (v = 1) first
+  return std::get<1>(key.sort(/*stable=*/true, /*dim=*/0, /*descending=*/false));
+}
+
 Gaussians initialise_gaussians(const uvd::UvTriangleLookup& lookup, int64_t count, double metres_per_uv,
                                bool bind_to_triangles, uint64_t seed, const at::TensorOptions& options) {
   at::NoGradGuard no_grad;
   Gaussians g;
-  const at::Tensor uv = lookup.sample_uniform(count, seed).to(options);
+  const at::Tensor sampled = lookup.sample_uniform(count, seed).to(options);
+  const at::Tensor uv = sampled.index_select(0, uv_order(sampled));
   g.uvd = at::cat({uv, at::zeros({count, 1}, options)}, 1);
   // Mean spacing of `count` points over the valid UV area.
   const double uv_area = lookup.uv_area().sum().item<double>();
