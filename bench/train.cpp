@@ -3,11 +3,15 @@
 // densification), with peak GPU memory and the Gaussian count.
 //
 //   train_bench --data DATASET [--iterations 60] [--gaussians N] [--device cuda]
-//               [--densify] [--set key=value ...]
+//               [--densify] [--set key=value ...] [--trace FILE]
 //
 // Without --densify the count stays at --gaussians, so a size (e.g. 4M at
 // 3072x2048) is measured directly. The field and shading are active from the
 // first iteration (no warm-up), as in the steady state of a real run.
+//
+// --trace (CUDA builds) records three more, unprofiled iterations with the
+// PyTorch (Kineto) profiler into a Chrome trace; bench/trace_summary.py turns
+// it into GPU milliseconds per part of the model, forward and backward.
 
 #include <ATen/ATen.h>
 
@@ -23,7 +27,30 @@
 
 #ifdef TEGA_TORCH_HAS_CUDA
 #include <c10/cuda/CUDACachingAllocator.h>
+#include <torch/csrc/autograd/profiler_kineto.h>
 #endif
+
+namespace {
+
+// Runs `work` under the Kineto profiler (CPU ops and CUDA kernels) and saves a Chrome trace.
+template <class Work>
+void trace_to(const std::string& path, Work&& work) {
+#ifdef TEGA_TORCH_HAS_CUDA
+  namespace profiler = torch::autograd::profiler;
+  using torch::profiler::impl::ActivityType;
+  const torch::profiler::impl::ProfilerConfig config(torch::profiler::impl::ProfilerState::KINETO);
+  const std::set<ActivityType> activities{ActivityType::CPU, ActivityType::CUDA};
+  profiler::prepareProfiler(config, activities);
+  profiler::enableProfiler(config, activities);
+  work();
+  profiler::disableProfiler()->save(path);
+#else
+  (void)work;
+  throw tega::Error("--trace " + path + ": this build has no CUDA profiler");
+#endif
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"Times TeGA training iterations."};
@@ -31,12 +58,14 @@ int main(int argc, char** argv) {
   int64_t iterations = 60, gaussians = 500000;
   bool densify = false;
   std::vector<std::string> overrides;
+  std::string trace;
   app.add_option("--data", data, "Dataset directory.")->required();
   app.add_option("--iterations", iterations, "Timed iterations (after 5 untimed warm-up iterations).");
   app.add_option("--gaussians", gaussians, "Gaussians (initial count).");
   app.add_option("--device", device, "cpu or cuda.");
   app.add_flag("--densify", densify, "Keep densification on (the count then changes).");
   app.add_option("--set", overrides, "Training option override key=value (repeatable).");
+  app.add_option("--trace", trace, "Chrome trace of three further iterations (Kineto; CUDA builds).");
   CLI11_PARSE(app, argc, argv);
   tega::init_logging(0);
 
@@ -81,6 +110,12 @@ int main(int argc, char** argv) {
     }
     std::printf("| **total** | **%.2f** |\n", total);
     std::printf("(the profile waits for the GPU between parts; training without --profile overlaps them)\n");
+    if (!trace.empty()) {
+      options.profile = false;
+      options.iterations += 3;
+      trace_to(trace, [&] { tega::trainer::train(data, run, options, {.resume = true}); });
+      std::printf("trace of 3 iterations: %s\n", trace.c_str());
+    }
   } catch (const tega::Error& e) {
     std::fprintf(stderr, "train_bench: %s\n", e.what());
     return 1;

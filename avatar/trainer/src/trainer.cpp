@@ -4,6 +4,7 @@
 #include <ATen/core/grad_mode.h>
 #include <ATen/CPUGeneratorImpl.h>
 #include <ATen/Parallel.h>
+#include <ATen/record_function.h>
 
 #include <chrono>
 #include <cmath>
@@ -194,6 +195,7 @@ class Run {
 
   // Forward, backward and update on one view. Returns (loss, mse).
   std::pair<double, double> step(const LoadedView& loaded) {
+    RECORD_FUNCTION("tega::step", std::vector<c10::IValue>());
     const Camera& camera = dataset_.rig.cameras[loaded.view.camera];
     const Phase p = phase();
     update_learning_rates();
@@ -203,18 +205,26 @@ class Run {
     PosedGaussians posed = model_.pose(frame, camera.center(), p);
 
     profiler_.section("rasterization");
-    const splat::RasterOutput raster =
-        splat::rasterize(posed.means, posed.covariances, posed.colors, posed.opacities, background_,
-                         {raster_camera(camera)}, raster_settings(camera, options_.antialiased), &stats_);
+    splat::RasterOutput raster;
+    {
+      RECORD_FUNCTION("tega::rasterization", std::vector<c10::IValue>());
+      raster = splat::rasterize(posed.means, posed.covariances, posed.colors, posed.opacities, background_,
+                                {raster_camera(camera)}, raster_settings(camera, options_.antialiased), &stats_);
+    }
 
     profiler_.section("losses");
     const at::Tensor rendered = raster.rgb[0].permute({2, 0, 1});
     const at::Tensor target = composite_target(loaded.rgba.to(device_), background_);
-    at::Tensor loss = options_.loss.l1 * nn::l1_image_loss(rendered, target) +
-                      options_.loss.dssim * nn::dssim_loss(rendered, target);
+    at::Tensor loss;
+    {
+      RECORD_FUNCTION("tega::image_losses", std::vector<c10::IValue>());
+      loss = options_.loss.l1 * nn::l1_image_loss(rendered, target) +
+             options_.loss.dssim * nn::dssim_loss(rendered, target);
+    }
     const double vgg_weight = schedules::vgg_weight(options_.loss, iteration_, options_.iterations);
     if (vgg_ && vgg_weight > 0) loss = loss + vgg_weight * (*vgg_)(rendered.unsqueeze(0), target.unsqueeze(0));
     if (p.deformation && options_.loss.smoothness_samples > 0) {
+      RECORD_FUNCTION("tega::smoothness", std::vector<c10::IValue>());
       const at::Tensor samples =
           nn::sample_smoothness_uvd(options_.loss.smoothness_samples, at::TensorOptions(at::kFloat), generator_)
               .to(device_);
@@ -234,9 +244,10 @@ class Run {
     if (v[2] == 0.0) report_non_finite(loaded);
 
     profiler_.section("optimizer");
-    adam_.step();
-    clamp_world_size(model_.gaussians, posed.world_std_per_scale, options_.min_std, options_.max_std);
     {
+      RECORD_FUNCTION("tega::optimizer", std::vector<c10::IValue>());
+      adam_.step();
+      clamp_world_size(model_.gaussians, posed.world_std_per_scale, options_.min_std, options_.max_std);
       at::NoGradGuard no_grad;
       const at::Tensor world_std = (model_.gaussians.log_scale.exp() * posed.world_std_per_scale).amax(1);
       max_world_std_ = at::max(max_world_std_, world_std);

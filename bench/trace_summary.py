@@ -1,0 +1,101 @@
+#!/usr/bin/env python3
+"""GPU time per part of a TeGA training step, from a Chrome trace of
+`train_bench --trace` (PyTorch's Kineto profiler).
+
+Only kernels launched inside a training step (the `tega::step` scope) count,
+not the checkpoint I/O or the held-out evaluation around them. Each is charged
+to the innermost `tega::` scope around the op that launched it (see
+TEGA_TRACE_SCOPE in avatar_model.cpp). Kernels launched by the autograd
+engine are charged, through the op's sequence number, to the scope of the
+forward op they differentiate, as "<part> backward".
+
+    bench/trace_summary.py TRACE.json [--top 25]
+"""
+import argparse
+import bisect
+import collections
+import json
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("trace")
+    ap.add_argument("--top", type=int, default=25)
+    args = ap.parse_args()
+    with open(args.trace) as f:
+        events = json.load(f)["traceEvents"]
+
+    ops = [e for e in events if e.get("ph") == "X" and e.get("cat") in ("cpu_op", "user_annotation")]
+    kernels = [e for e in events if e.get("ph") == "X" and e.get("cat") in ("kernel", "gpu_memcpy", "gpu_memset")]
+
+    # Innermost enclosing tega:: scope of every op, per thread, by time nesting.
+    by_thread = collections.defaultdict(list)
+    for op in ops:
+        by_thread[op["tid"]].append(op)
+    scope_of_op = {}
+    for thread_ops in by_thread.values():
+        thread_ops.sort(key=lambda e: (e["ts"], -e["dur"]))
+        stack = []  # (end, scope)
+        for op in thread_ops:
+            while stack and stack[-1][0] < op["ts"]:
+                stack.pop()
+            inherited = stack[-1][1] if stack else None
+            scope = op["name"][len("tega::"):] if op["name"].startswith("tega::") else inherited
+            stack.append((op["ts"] + op["dur"], scope))
+            scope_of_op[id(op)] = scope
+
+    # Forward scope by sequence number, for the backward ops.
+    forward_scope = {}
+    for op in ops:
+        seq = op.get("args", {}).get("Sequence number")
+        if seq is not None and not op["name"].startswith("autograd::") and scope_of_op[id(op)]:
+            forward_scope.setdefault(seq, scope_of_op[id(op)])
+    backward_nodes = sorted(
+        (op for op in ops if op["name"].startswith("autograd::engine::evaluate_function")),
+        key=lambda e: e["ts"])
+    node_starts = [op["ts"] for op in backward_nodes]
+
+    def part_of(op):
+        scope = scope_of_op[id(op)]
+        i = bisect.bisect_right(node_starts, op["ts"]) - 1
+        if i >= 0 and backward_nodes[i]["tid"] == op["tid"] and op["ts"] <= node_starts[i] + backward_nodes[i]["dur"]:
+            seq = backward_nodes[i].get("args", {}).get("Sequence number")
+            return f"{forward_scope.get(seq, 'other')} backward"
+        return scope or "other"
+
+    op_by_external = {}
+    for op in ops:
+        ext = op.get("args", {}).get("External id")
+        if ext is not None:
+            op_by_external[ext] = op  # later (inner) ops overwrite outer ones with the same id
+
+    steps = sorted((op["ts"], op["ts"] + op["dur"]) for op in ops if op["name"] == "tega::step")
+    step_starts = [s for s, _ in steps]
+
+    def in_step(op):
+        i = bisect.bisect_right(step_starts, op["ts"]) - 1
+        return i >= 0 and op["ts"] <= steps[i][1]
+
+    per_part = collections.Counter()
+    per_kernel = collections.Counter()
+    for k in kernels:
+        op = op_by_external.get(k.get("args", {}).get("External id"))
+        if op is None or not in_step(op):
+            continue
+        part = part_of(op)
+        per_part[part] += k["dur"]
+        per_kernel[(part, k["name"][:90])] += k["dur"]
+
+    n = len(steps) or 1
+    total = sum(per_part.values())
+    print(f"GPU time per iteration: {total / 1000 / n:.2f} ms over {n} steps (kernels, memcpy and memset)")
+    print("| part | ms / iteration | share |\n|---|---:|---:|")
+    for part, us in per_part.most_common():
+        print(f"| {part} | {us / 1000 / n:.2f} | {100 * us / total:.1f}% |")
+    print(f"\nTop {args.top} kernels:\n| part | kernel | ms / iteration |\n|---|---|---:|")
+    for (part, name), us in per_kernel.most_common(args.top):
+        print(f"| {part} | `{name}` | {us / 1000 / n:.2f} |")
+
+
+if __name__ == "__main__":
+    main()
