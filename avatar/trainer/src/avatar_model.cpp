@@ -1,6 +1,7 @@
 #include "tega/trainer/avatar_model.h"
 
 #include <ATen/core/grad_mode.h>
+#include <ATen/record_function.h>
 
 #include <cmath>
 
@@ -26,6 +27,10 @@ double metres_per_uv(const Mesh& mesh) {
 }
 
 namespace {
+
+// Names a part of pose() in profiler traces (bench/train --trace); backward
+// kernels are attributed to it through their forward op.
+#define TEGA_TRACE_SCOPE(name) RECORD_FUNCTION("tega::" name, std::vector<c10::IValue>())
 
 at::Tensor to_tensor(const Vertices& v, const at::Device& device) {
   return at::from_blob(const_cast<float*>(v.data()), {v.rows(), 3}, at::kFloat).to(device, /*non_blocking=*/false,
@@ -69,36 +74,56 @@ FrameInput AvatarModel::frame_input(const Vertices& world_vertices, const RigidT
 PosedGaussians AvatarModel::pose(const FrameInput& frame, const Eigen::Vector3d& camera_centre, const Phase& phase) {
   PosedGaussians out;
   const Gaussians& g = gaussians;
-  const uvd::UvdMapping mapping = uvd::uvd_to_world(g.uvd, frame.mesh, lookup_, g.bound_triangle);
-  at::Tensor means = mapping.xyz;
-  at::Tensor jacobian = mapping.jacobian;
+  at::Tensor means, jacobian, triangle;
+  {
+    TEGA_TRACE_SCOPE("uvd_to_world");
+    uvd::UvdMapping mapping = uvd::uvd_to_world(g.uvd, frame.mesh, lookup_, g.bound_triangle);
+    means = std::move(mapping.xyz);
+    jacobian = std::move(mapping.jacobian);
+    triangle = std::move(mapping.triangle);
+  }
 
   at::Tensor shading;
   if (phase.deformation || phase.shading) {
-    out.latents = network->encode(frame.displacement_texture);
+    {
+      TEGA_TRACE_SCOPE("encoder");
+      out.latents = network->encode(frame.displacement_texture);
+    }
     if (phase.deformation) {
+      TEGA_TRACE_SCOPE("deformation_field");
       const nn::FieldWithJacobian field = network->deform(g.uvd, out.latents, /*with_jacobian=*/true);
-      const at::Tensor movable = eyeball_face_mask_.index_select(0, mapping.triangle).logical_not().to(means.dtype());
+      const at::Tensor movable = eyeball_face_mask_.index_select(0, triangle).logical_not().to(means.dtype());
       // Head space -> world: Δ_world = R Δ, J_world = R J (row vectors: Δ Rᵀ).
       means = means + field.value.matmul(frame.head_rotation.t()) * movable.unsqueeze(1);
-      jacobian = jacobian + frame.head_rotation.matmul(field.jacobian) * movable.view({-1, 1, 1});
+      // R J_D for every Gaussian as one [3N,3]x[3,3] product: (J_Dᵀ Rᵀ)ᵀ.
+      const at::Tensor rotated = field.jacobian.transpose(1, 2).reshape({-1, 3}).matmul(frame.head_rotation.t());
+      jacobian = jacobian + rotated.view({-1, 3, 3}).transpose(1, 2) * movable.view({-1, 1, 1});
     }
-    if (phase.shading) shading = network->shade(g.uvd, out.latents);
+    if (phase.shading) {
+      TEGA_TRACE_SCOPE("shading_field");
+      shading = network->shade(g.uvd, out.latents);
+    }
   }
 
-  const at::Tensor rotation = uvd::rotation_from_quaternion(g.rotation);
-  const at::Tensor jacobian_rotation = jacobian.bmm(rotation);  // [N,3,3]
-  const at::Tensor shape = jacobian_rotation * g.log_scale.exp().unsqueeze(1);  // columns scaled by std
-  out.covariances = uvd::pack_symmetric(shape.bmm(shape.transpose(1, 2)));
-  out.world_std_per_scale = jacobian_rotation.detach().norm(2, 1);
+  {
+    TEGA_TRACE_SCOPE("covariance");
+    const at::Tensor rotation = uvd::rotation_from_quaternion(g.rotation);
+    const at::Tensor jacobian_rotation = uvd::batched_matmul(jacobian, rotation);  // [N,3,3]
+    const at::Tensor shape = jacobian_rotation * g.log_scale.exp().unsqueeze(1);    // columns scaled by std
+    out.covariances = uvd::packed_gram(shape);
+    out.world_std_per_scale = jacobian_rotation.detach().norm(2, 1);
+  }
   out.means = means;
 
-  const at::Tensor centre = at::tensor({camera_centre.x(), camera_centre.y(), camera_centre.z()},
-                                       means.options().requires_grad(false));
-  at::Tensor colors = sh_to_rgb(at::cat({g.sh_dc, g.sh_rest}, 1), means - centre, phase.sh_degree);
-  if (shading.defined()) colors = colors * shading.unsqueeze(1);
-  out.colors = colors;
-  out.opacities = at::sigmoid(g.opacity_logit);
+  {
+    TEGA_TRACE_SCOPE("colors");
+    const at::Tensor centre = at::tensor({camera_centre.x(), camera_centre.y(), camera_centre.z()},
+                                         means.options().requires_grad(false));
+    at::Tensor colors = sh_to_rgb(at::cat({g.sh_dc, g.sh_rest}, 1), means - centre, phase.sh_degree);
+    if (shading.defined()) colors = colors * shading.unsqueeze(1);
+    out.colors = colors;
+    out.opacities = at::sigmoid(g.opacity_logit);
+  }
   return out;
 }
 

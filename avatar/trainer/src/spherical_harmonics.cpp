@@ -13,23 +13,24 @@ at::Tensor sh_to_rgb(const at::Tensor& sh, const at::Tensor& directions, int deg
   constexpr double c3[] = {-0.5900435899266435, 2.890611442640554, -0.4570457994644658, 0.3731763325901154,
                            -0.4570457994644658, 1.445305721320277, -0.5900435899266435};
 
+  // The basis [N,K] first, then one product with the coefficients: a sum of
+  // K [N,3] terms costs K passes over memory forward and more backward.
   const at::Tensor d = directions / directions.norm(2, 1, true).clamp_min(1e-12);
-  const at::Tensor x = d.select(1, 0).unsqueeze(1), y = d.select(1, 1).unsqueeze(1), z = d.select(1, 2).unsqueeze(1);
-  const auto h = [&](int k) { return sh.select(1, k); };  // [N, 3]
-
-  at::Tensor rgb = c0 * h(0);
-  if (degree >= 1) rgb = rgb - c1 * y * h(1) + c1 * z * h(2) - c1 * x * h(3);
+  const at::Tensor x = d.select(1, 0), y = d.select(1, 1), z = d.select(1, 2);
+  std::vector<at::Tensor> basis{at::full_like(x, c0)};
+  if (degree >= 1) basis.insert(basis.end(), {-c1 * y, c1 * z, -c1 * x});
   if (degree >= 2) {
     const at::Tensor xx = x * x, yy = y * y, zz = z * z, xy = x * y, yz = y * z, xz = x * z;
-    rgb = rgb + c2[0] * xy * h(4) + c2[1] * yz * h(5) + c2[2] * (2.0 * zz - xx - yy) * h(6) + c2[3] * xz * h(7) +
-          c2[4] * (xx - yy) * h(8);
+    basis.insert(basis.end(), {c2[0] * xy, c2[1] * yz, c2[2] * (2.0 * zz - xx - yy), c2[3] * xz, c2[4] * (xx - yy)});
     if (degree >= 3) {
-      rgb = rgb + c3[0] * y * (3.0 * xx - yy) * h(9) + c3[1] * xy * z * h(10) +
-            c3[2] * y * (4.0 * zz - xx - yy) * h(11) + c3[3] * z * (2.0 * zz - 3.0 * xx - 3.0 * yy) * h(12) +
-            c3[4] * x * (4.0 * zz - xx - yy) * h(13) + c3[5] * z * (xx - yy) * h(14) +
-            c3[6] * x * (xx - 3.0 * yy) * h(15);
+      basis.insert(basis.end(), {c3[0] * y * (3.0 * xx - yy), c3[1] * xy * z, c3[2] * y * (4.0 * zz - xx - yy),
+                                 c3[3] * z * (2.0 * zz - 3.0 * xx - 3.0 * yy), c3[4] * x * (4.0 * zz - xx - yy),
+                                 c3[5] * z * (xx - yy), c3[6] * x * (xx - 3.0 * yy)});
     }
   }
+  const int64_t k = static_cast<int64_t>(basis.size());
+  TORCH_CHECK(sh.dim() == 3 && sh.size(1) >= k && sh.size(2) == 3, "sh must be [N,>=", k, ",3], got ", sh.sizes());
+  const at::Tensor rgb = (at::stack(basis, 1).unsqueeze(2) * sh.narrow(1, 0, k)).sum(1);
   return (rgb + 0.5).clamp_min(0.0);
 }
 

@@ -15,19 +15,19 @@ at::Tensor rotation_from_quaternion(const at::Tensor& quaternion) {
 
 at::Tensor covariance_from_scale_rotation(const at::Tensor& scale, const at::Tensor& quaternion) {
   const auto m = rotation_from_quaternion(quaternion) * scale.unsqueeze(1);  // R diag(s)
-  return m.matmul(m.transpose(1, 2));
+  return batched_matmul(m, m.transpose(1, 2));
 }
 
 at::Tensor world_covariance(const at::Tensor& jacobian, const at::Tensor& covariance_uvd) {
   TORCH_CHECK(jacobian.dim() == 3 && jacobian.size(1) == 3 && jacobian.size(2) == 3, "jacobian must be [N,3,3]");
-  const auto product = jacobian.matmul(covariance_uvd).matmul(jacobian.transpose(1, 2));
+  const auto product = batched_matmul(batched_matmul(jacobian, covariance_uvd), jacobian.transpose(1, 2));
   // Rounding leaves the product slightly asymmetric; the rasterizer assumes symmetry.
   return 0.5 * (product + product.transpose(1, 2));
 }
 
 at::Tensor world_covariance(const at::Tensor& jacobian, const at::Tensor& scale, const at::Tensor& quaternion) {
-  const auto m = jacobian.matmul(rotation_from_quaternion(quaternion) * scale.unsqueeze(1));  // J R diag(s)
-  return m.matmul(m.transpose(1, 2));
+  const auto m = batched_matmul(jacobian, rotation_from_quaternion(quaternion) * scale.unsqueeze(1));  // J R diag(s)
+  return batched_matmul(m, m.transpose(1, 2));
 }
 
 at::Tensor pack_symmetric(const at::Tensor& matrix) {
@@ -41,6 +41,19 @@ at::Tensor unpack_symmetric(const at::Tensor& packed) {
   TORCH_CHECK(packed.dim() == 2 && packed.size(1) == 6, "packed covariance must be [N,6]");
   const auto c = [&](int k) { return packed.select(1, k); };
   return at::stack({c(0), c(1), c(2), c(1), c(3), c(4), c(2), c(4), c(5)}, 1).view({-1, 3, 3});
+}
+
+at::Tensor packed_gram(const at::Tensor& m) {
+  TORCH_CHECK(m.dim() == 3 && m.size(1) == 3, "packed_gram: m must be [N,3,k]");
+  const auto rows = at::tensor({0, 0, 0, 1, 1, 2}, at::TensorOptions(at::kLong).device(m.device()));
+  const auto cols = at::tensor({0, 1, 2, 1, 2, 2}, at::TensorOptions(at::kLong).device(m.device()));
+  return (m.index_select(1, rows) * m.index_select(1, cols)).sum(2);
+}
+
+at::Tensor batched_matmul(const at::Tensor& a, const at::Tensor& b) {
+  TORCH_CHECK(a.dim() == 3 && b.dim() == 3 && a.size(2) == b.size(1), "batched_matmul: shapes ", a.sizes(), " and ",
+              b.sizes(), " do not multiply");
+  return (a.unsqueeze(3) * b.unsqueeze(1)).sum(2);
 }
 
 }  // namespace tega::uvd

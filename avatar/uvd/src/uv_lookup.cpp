@@ -26,7 +26,7 @@ at::Tensor UvTriangleLookup::barycentrics_in(const at::Tensor& uv, const at::Ten
   const Tables& t = tables(uv.scalar_type());
   const auto corner0 = t.corners.index_select(0, triangle).select(1, 0);
   // Relative to a corner, so float32 keeps its precision on small triangles.
-  const auto b12 = at::matmul(t.inverse.index_select(0, triangle), (uv - corner0).unsqueeze(-1)).squeeze(-1);
+  const auto b12 = (t.inverse.index_select(0, triangle) * (uv - corner0).unsqueeze(1)).sum(2);  // [N,2,2]·[N,2]
   return at::cat({1 - b12.sum(1, /*keepdim=*/true), b12}, 1);
 }
 

@@ -1,5 +1,7 @@
 #include "tega/uvd/uvd_map.h"
 
+#include "tega/uvd/covariance.h"
+
 namespace tega::uvd {
 namespace {
 
@@ -61,8 +63,8 @@ UvdMapping uvd_to_world(const at::Tensor& uvd, const PosedMesh& mesh, const UvTr
   const auto m_length = m.norm(2, 1, /*keepdim=*/true).clamp_min(kMinNormalLength);
   const auto n = m / m_length;
 
-  const auto dposition = v.transpose(1, 2).matmul(db);  // [N,3,2]
-  const auto dm = nv.transpose(1, 2).matmul(db);
+  const auto dposition = batched_matmul(v.transpose(1, 2), db);  // [N,3,2]
+  const auto dm = batched_matmul(nv.transpose(1, 2), db);
   const auto dn = (dm - n.unsqueeze(-1) * (n.unsqueeze(-1) * dm).sum(1, /*keepdim=*/true)) / m_length.unsqueeze(-1);
   const auto jacobian = at::cat({dposition + d.unsqueeze(-1) * dn, n.unsqueeze(-1)}, 2);
   return {position + d * n, jacobian, triangle};

@@ -1,6 +1,7 @@
 #include <ATen/ATen.h>
 #include <gtest/gtest.h>
 
+#include "tega/splat/gaussian_math.h"
 #include "tega/trainer/adam.h"
 #include "tega/trainer/spherical_harmonics.h"
 
@@ -74,6 +75,21 @@ TEST(SphericalHarmonics, DegreeOneFollowsTheViewDirection) {
   const at::Tensor rgb = tega::trainer::sh_to_rgb(sh, dirs, 1);
   EXPECT_NEAR(rgb[0][0].item<double>(), 0.5 - 0.4886025119029199 * 0.1, 1e-12);
   EXPECT_NEAR(rgb[1][0].item<double>(), 0.5 + 0.4886025119029199 * 0.1, 1e-12);
+}
+
+TEST(SphericalHarmonics, MatchesTheRasterizersEvaluationAtEveryDegree) {
+  const at::Tensor sh = at::randn({9, 16, 3}, at::kDouble) * 0.3;
+  const at::Tensor dirs = at::randn({9, 3}, at::kDouble);
+  for (int degree = 0; degree <= 3; ++degree) {
+    const at::Tensor rgb = tega::trainer::sh_to_rgb(sh, dirs, degree);
+    for (int64_t i = 0; i < 9; ++i) {
+      double expected[3];
+      const at::Tensor row = sh[i].contiguous(), dir = dirs[i].contiguous();
+      tega::splat::sh_to_rgb<double>(degree, row.data_ptr<double>(), dir.data_ptr<double>(), expected);
+      for (int ch = 0; ch < 3; ++ch)
+        EXPECT_NEAR(rgb[i][ch].item<double>(), expected[ch], 1e-14) << "degree " << degree << ", Gaussian " << i;
+    }
+  }
 }
 
 }  // namespace
