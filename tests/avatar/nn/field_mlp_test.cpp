@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 #include <torch/csrc/autograd/autograd.h>
 
+#include <cmath>
+
 namespace tega::nn {
 namespace {
 
@@ -33,16 +35,35 @@ at::Tensor autograd_jacobian(FieldMLP& mlp, const at::Tensor& uvd, const at::Ten
   return at::stack(rows, 1);
 }
 
-TEST(PositionalEncoding, JacobianMatchesAutograd) {
+TEST(PositionalEncoding, AxisDerivativesMatchAutograd) {
   const PositionalEncoding pe{4, 3.0};
   const at::Tensor uvd = random_uvd(7).requires_grad_(true);
   const at::Tensor encoded = pe.encode(uvd);
   ASSERT_EQ(encoded.sizes(), (std::vector<int64_t>{7, pe.channels()}));
-  const at::Tensor analytic = pe.jacobian(uvd.detach());
-  ASSERT_EQ(analytic.sizes(), (std::vector<int64_t>{7, 3, pe.channels()}));
-  for (int64_t p = 0; p < pe.channels(); ++p) {
-    const at::Tensor g = torch::autograd::grad({encoded.select(1, p).sum()}, {uvd}, {}, true)[0];  // [N,3]
-    EXPECT_TRUE(at::allclose(analytic.select(2, p), g, 1e-12, 1e-12)) << "feature " << p;
+  const at::Tensor analytic = pe.axis_derivatives(uvd.detach());
+  ASSERT_EQ(analytic.sizes(), (std::vector<int64_t>{3, 7, pe.features()}));
+  for (int64_t f = 0; f < pe.features(); ++f) {
+    for (int64_t a = 0; a < 3; ++a) {
+      const at::Tensor g = torch::autograd::grad({encoded.select(1, 3 * f + a).sum()}, {uvd}, {}, true)[0];  // [N,3]
+      EXPECT_TRUE(at::allclose(analytic[a].select(1, f), g.select(1, a), 1e-12, 1e-12)) << "feature " << f;
+      for (int64_t other = 0; other < 3; ++other) {
+        if (other != a) EXPECT_EQ(g.select(1, other).abs().max().item<double>(), 0.0) << "feature " << f;
+      }
+    }
+  }
+}
+
+TEST(PositionalEncoding, ChannelsAreFeatureMajorAxisMinor) {
+  const PositionalEncoding pe{2, 3.0};
+  const at::Tensor uvd = at::tensor({0.25, 0.5, 0.01}, at::kDouble).view({1, 3});
+  const at::Tensor e = pe.encode(uvd).view({-1});
+  const double x[3] = {0.25, 0.5, 0.03};
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_DOUBLE_EQ(e[a].item<double>(), x[a]);
+    EXPECT_NEAR(e[3 + a].item<double>(), std::sin(M_PI * x[a]), 1e-15);         // f = 1: sin, octave 0
+    EXPECT_NEAR(e[6 + a].item<double>(), std::cos(M_PI * x[a]), 1e-15);         // f = 2: cos, octave 0
+    EXPECT_NEAR(e[9 + a].item<double>(), std::sin(2 * M_PI * x[a]), 1e-15);     // f = 3: sin, octave 1
+    EXPECT_NEAR(e[12 + a].item<double>(), std::cos(2 * M_PI * x[a]), 1e-15);    // f = 4: cos, octave 1
   }
 }
 

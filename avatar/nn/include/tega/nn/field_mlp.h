@@ -34,14 +34,20 @@ namespace tega::nn {
 // x = (u, v, depth_scale·d) with d in metres. depth_scale maps d to units
 // comparable with uv (1 unit of u spans roughly 0.3 m of face, so the
 // default 3 makes 1 unit of scaled d ≈ 0.33 m).
+//
+// Channel 3f + a is feature f (x, then sin and cos per octave) of axis a, so
+// every channel depends on one axis only: its derivative is a single number,
+// and axis_derivatives() holds [3, N, features()] of them instead of a mostly
+// zero [N, 3, channels()] Jacobian.
 struct PositionalEncoding {
   int64_t frequencies = 6;
   double depth_scale = 3.0;
 
-  int64_t channels() const { return 3 + 6 * frequencies; }
+  int64_t features() const { return 1 + 2 * frequencies; }
+  int64_t channels() const { return 3 * features(); }
   at::Tensor encode(const at::Tensor& uvd) const;  // [N,3] → [N,channels()]
-  // d encode / d uvd as [N, 3 (uvd), channels()]; row a is the tangent of uvd axis a.
-  at::Tensor jacobian(const at::Tensor& uvd) const;
+  // ∂ channel (3f + a) / ∂ uvd_a as [3 (a), N, features() (f)].
+  at::Tensor axis_derivatives(const at::Tensor& uvd) const;
 };
 
 struct FieldMLPOptions {
@@ -67,7 +73,7 @@ class FieldMLPImpl : public torch::nn::Module {
   const FieldMLPOptions& options() const { return options_; }
 
  private:
-  at::Tensor first_layer_input(const at::Tensor& uvd, const at::Tensor& condition) const;
+  at::Tensor first_layer(const at::Tensor& uvd, const at::Tensor& condition) const;  // pre-activation
 
   FieldMLPOptions options_;
   torch::nn::Linear input_{nullptr}, hidden_{nullptr}, output_{nullptr};
