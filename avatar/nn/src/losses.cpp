@@ -1,5 +1,7 @@
 #include "tega/nn/losses.h"
 
+#include "tega/nn/fused_ssim.h"
+
 #include <ATen/ATen.h>
 
 #include <cmath>
@@ -49,7 +51,9 @@ at::Tensor ssim(const at::Tensor& a_in, const at::Tensor& b_in) {
   return map.mean();
 }
 
-at::Tensor dssim_loss(const at::Tensor& rendered, const at::Tensor& target) { return 1 - ssim(rendered, target); }
+at::Tensor dssim_loss(const at::Tensor& rendered, const at::Tensor& target) {
+  return 1 - fused_ssim(rendered, target);
+}
 
 at::Tensor jacobian_smoothness_loss(const at::Tensor& jacobians, Reduction reduction) {
   TORCH_CHECK(jacobians.dim() == 3 && jacobians.size(1) == 3 && jacobians.size(2) == 3,

@@ -16,9 +16,11 @@ at::Tensor l1_image_loss(const at::Tensor& rendered, const at::Tensor& target);
 
 // Mean SSIM as in 3DGS: 11x11 Gaussian window (σ = 1.5) applied per channel
 // by conv2d with zero padding (so the output keeps the image size),
-// C1 = 0.01², C2 = 0.03² for a data range of 1.
+// C1 = 0.01², C2 = 0.03² for a data range of 1. Plain torch ops: the
+// reference that fused_ssim (fused_ssim.h) is tested against.
 at::Tensor ssim(const at::Tensor& a, const at::Tensor& b);
-// 1 - SSIM, the form 3DGS weighs by 0.2 (not (1 - SSIM)/2).
+// 1 - SSIM, the form 3DGS weighs by 0.2 (not (1 - SSIM)/2), through
+// fused_ssim: differentiable in `rendered` only, the target must not require grad.
 at::Tensor dssim_loss(const at::Tensor& rendered, const at::Tensor& target);
 
 // The deformation smoothness term, Eq. 8: ‖J_D‖_F² over random uvd samples.
