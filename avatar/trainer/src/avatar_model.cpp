@@ -119,7 +119,7 @@ PosedGaussians AvatarModel::pose(const FrameInput& frame, const Eigen::Vector3d&
     TEGA_TRACE_SCOPE("colors");
     const at::Tensor centre = at::tensor({camera_centre.x(), camera_centre.y(), camera_centre.z()},
                                          means.options().requires_grad(false));
-    at::Tensor colors = sh_to_rgb(at::cat({g.sh_dc, g.sh_rest}, 1), means - centre, phase.sh_degree);
+    at::Tensor colors = sh_to_rgb(g.sh_dc, g.sh_rest, means - centre, phase.sh_degree);
     if (shading.defined()) colors = colors * shading.unsqueeze(1);
     out.colors = colors;
     out.opacities = at::sigmoid(g.opacity_logit);

@@ -3,8 +3,10 @@
 #include <vector>
 
 namespace tega::trainer {
+namespace {
 
-at::Tensor sh_to_rgb(const at::Tensor& sh, const at::Tensor& directions, int degree) {
+// The real SH basis at the normalised directions: (degree+1)² tensors [N].
+std::vector<at::Tensor> sh_basis(const at::Tensor& directions, int degree) {
   // Real SH basis constants (the ones 3DGS uses).
   constexpr double c0 = 0.28209479177387814;
   constexpr double c1 = 0.4886025119029199;
@@ -13,8 +15,6 @@ at::Tensor sh_to_rgb(const at::Tensor& sh, const at::Tensor& directions, int deg
   constexpr double c3[] = {-0.5900435899266435, 2.890611442640554, -0.4570457994644658, 0.3731763325901154,
                            -0.4570457994644658, 1.445305721320277, -0.5900435899266435};
 
-  // The basis [N,K] first, then one product with the coefficients: a sum of
-  // K [N,3] terms costs K passes over memory forward and more backward.
   const at::Tensor d = directions / directions.norm(2, 1, true).clamp_min(1e-12);
   const at::Tensor x = d.select(1, 0), y = d.select(1, 1), z = d.select(1, 2);
   std::vector<at::Tensor> basis{at::full_like(x, c0)};
@@ -28,9 +28,28 @@ at::Tensor sh_to_rgb(const at::Tensor& sh, const at::Tensor& directions, int deg
                                  c3[5] * z * (xx - yy), c3[6] * x * (xx - 3.0 * yy)});
     }
   }
+  return basis;
+}
+
+// Σ_k basis_k coefficients_k as one product: [N,K]·[N,K,3] -> [N,3]. (A sum
+// of K [N,3] terms costs K passes over memory forward and more backward.)
+at::Tensor weighted_sum(const std::vector<at::Tensor>& basis, const at::Tensor& coefficients) {
   const int64_t k = static_cast<int64_t>(basis.size());
-  TORCH_CHECK(sh.dim() == 3 && sh.size(1) >= k && sh.size(2) == 3, "sh must be [N,>=", k, ",3], got ", sh.sizes());
-  const at::Tensor rgb = (at::stack(basis, 1).unsqueeze(2) * sh.narrow(1, 0, k)).sum(1);
+  TORCH_CHECK(coefficients.dim() == 3 && coefficients.size(1) >= k && coefficients.size(2) == 3,
+              "SH coefficients must be [N,>=", k, ",3], got ", coefficients.sizes());
+  return (at::stack(basis, 1).unsqueeze(2) * coefficients.narrow(1, 0, k)).sum(1);
+}
+
+}  // namespace
+
+at::Tensor sh_to_rgb(const at::Tensor& sh, const at::Tensor& directions, int degree) {
+  return (weighted_sum(sh_basis(directions, degree), sh) + 0.5).clamp_min(0.0);
+}
+
+at::Tensor sh_to_rgb(const at::Tensor& sh_dc, const at::Tensor& sh_rest, const at::Tensor& directions, int degree) {
+  std::vector<at::Tensor> basis = sh_basis(directions, degree);
+  at::Tensor rgb = basis.front().unsqueeze(1) * sh_dc.select(1, 0);
+  if (basis.size() > 1) rgb = rgb + weighted_sum({basis.begin() + 1, basis.end()}, sh_rest);
   return (rgb + 0.5).clamp_min(0.0);
 }
 

@@ -14,5 +14,8 @@ constexpr int sh_coefficients(int degree) { return (degree + 1) * (degree + 1); 
 // camera centre to the Gaussian) -> rgb [N, 3]. Differentiable in sh and
 // directions.
 at::Tensor sh_to_rgb(const at::Tensor& sh, const at::Tensor& directions, int degree);
+// The same with the coefficients split as the Gaussians store them: sh_dc
+// [N,1,3] and sh_rest [N,K-1,3] (no [N,K,3] copy is made).
+at::Tensor sh_to_rgb(const at::Tensor& sh_dc, const at::Tensor& sh_rest, const at::Tensor& directions, int degree);
 
 }  // namespace tega::trainer
