@@ -1,5 +1,7 @@
 #include "tega/nn/field_mlp.h"
 
+#include "tega/nn/silu_tangents.h"
+
 #include <ATen/ATen.h>
 #include <ATen/core/grad_mode.h>
 
@@ -7,11 +9,6 @@
 
 namespace tega::nn {
 namespace {
-
-at::Tensor silu_derivative(const at::Tensor& x) {
-  const at::Tensor s = at::sigmoid(x);
-  return s * (1 + x * (1 - s));
-}
 
 // Per-axis scale (1, 1, depth_scale), shaped to broadcast against [N,3].
 at::Tensor axis_scale(const at::Tensor& uvd, double depth_scale) {
@@ -94,16 +91,12 @@ FieldWithJacobian FieldMLPImpl::forward_with_jacobian(const at::Tensor& uvd, con
   const at::Tensor derivatives = options_.encoding.axis_derivatives(uvd);  // [3,N,features]
   std::vector<at::Tensor> axes;
   for (int64_t a = 0; a < 3; ++a) axes.push_back(at::mm(derivatives[a], pe_weight.select(2, a).t()));
-  at::Tensor pre = first_layer(uvd, condition);
-  at::Tensor tangent = silu_derivative(pre).unsqueeze(1) * at::stack(axes, 1);  // [N,3,hidden]
-  at::Tensor h = at::silu(pre);
-
-  pre = hidden_->forward(h);
-  tangent = silu_derivative(pre).unsqueeze(1) * tangent.reshape({n * 3, hidden}).matmul(hidden_->weight.t()).view({n, 3, hidden});
-  h = at::silu(pre);
-
-  const at::Tensor jacobian = tangent.reshape({n * 3, hidden}).matmul(output_->weight.t()).view({n, 3, -1});
-  return {output_->forward(h), jacobian.transpose(1, 2)};
+  SiluWithTangents layer = silu_with_tangents(first_layer(uvd, condition), at::stack(axes, 1));
+  const auto next_tangents = [&](const at::Tensor& weight) {
+    return layer.tangents.reshape({n * 3, hidden}).matmul(weight.t()).view({n, 3, -1});
+  };
+  layer = silu_with_tangents(hidden_->forward(layer.value), next_tangents(hidden_->weight));
+  return {output_->forward(layer.value), next_tangents(output_->weight).transpose(1, 2)};
 }
 
 }  // namespace tega::nn
