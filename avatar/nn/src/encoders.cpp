@@ -87,15 +87,4 @@ LatentPair GlobalEncoderImpl::forward(const at::Tensor& texture) {
           shading_head_->forward(pooled).unsqueeze(-1).unsqueeze(-1)};
 }
 
-at::Tensor sample_latent(const at::Tensor& latent, const at::Tensor& uv) {
-  TORCH_CHECK(latent.dim() == 3, "latent must be [C,H,W], got ", latent.sizes());
-  TORCH_CHECK(uv.dim() == 2 && uv.size(1) == 2, "uv must be [N,2], got ", uv.sizes());
-  // x = 2u - 1, y = 1 - 2v: grid_sample's y = -1 is the top row, v = 0 the bottom.
-  const at::Tensor grid = at::stack({uv.select(1, 0) * 2 - 1, 1 - uv.select(1, 1) * 2}, 1);
-  constexpr int64_t kBilinear = 0, kBorder = 1;
-  const at::Tensor sampled = at::grid_sampler(latent.unsqueeze(0), grid.to(latent.scalar_type()).view({1, 1, -1, 2}),
-                                              kBilinear, kBorder, /*align_corners=*/false);
-  return sampled.view({latent.size(0), uv.size(0)}).t();  // [1,C,1,N] → [N,C]
-}
-
 }  // namespace tega::nn
