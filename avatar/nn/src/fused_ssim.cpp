@@ -9,23 +9,16 @@
 #include <ATen/core/grad_mode.h>
 #include <torch/csrc/autograd/custom_function.h>
 
+#include "tega/avatar/device_dispatch.h"
+
 namespace tega::nn {
 namespace {
 
 using torch::autograd::AutogradContext;
 using torch::autograd::variable_list;
 
-bool use_cuda(const at::Tensor& a) {
-  if (!a.is_cuda()) return false;
-#if defined(TEGA_HAVE_CUDA) && defined(TEGA_TORCH_HAS_CUDA)
-  return true;
-#else
-  TORCH_CHECK(false, "fused_ssim: tensors are on a GPU but this build has no CUDA kernels");
-#endif
-}
-
 fused_ssim_glue::Forward run_forward(const at::Tensor& a, const at::Tensor& b, bool with_gradient) {
-  if (use_cuda(a)) {
+  if (use_cuda_kernels(a, "fused_ssim")) {
 #if defined(TEGA_HAVE_CUDA) && defined(TEGA_TORCH_HAS_CUDA)
     return fused_ssim_glue::forward_cuda(a, b, with_gradient);
 #endif
@@ -35,7 +28,7 @@ fused_ssim_glue::Forward run_forward(const at::Tensor& a, const at::Tensor& b, b
 
 at::Tensor run_backward(const at::Tensor& a, const at::Tensor& b, const at::Tensor& d_maps,
                         const at::Tensor& grad_output) {
-  if (use_cuda(a)) {
+  if (use_cuda_kernels(a, "fused_ssim")) {
 #if defined(TEGA_HAVE_CUDA) && defined(TEGA_TORCH_HAS_CUDA)
     return fused_ssim_glue::backward_cuda(a, b, d_maps, grad_output);
 #endif

@@ -9,6 +9,7 @@
 
 #include "latent_sampling_glue.h"
 #include "latent_sampling_math.h"
+#include "tega/avatar/device_dispatch.h"
 #include "tega/nn/encoders.h"
 
 namespace tega::nn {
@@ -80,23 +81,16 @@ namespace {
 using torch::autograd::AutogradContext;
 using torch::autograd::variable_list;
 
-bool on_cuda(const at::Tensor& t) {
-  if (!t.is_cuda()) return false;
-#if defined(TEGA_HAVE_CUDA) && defined(TEGA_TORCH_HAS_CUDA)
-  return true;
-#else
-  TORCH_CHECK(false, "sample_latent: tensors are on a GPU but this build has no CUDA kernels");
-#endif
-}
-
 // latent channels-last [H,W,C], uv [N,2] -> [N,C].
 class SampleLatentFunction : public torch::autograd::Function<SampleLatentFunction> {
  public:
   static at::Tensor forward(AutogradContext* ctx, const at::Tensor& latent, const at::Tensor& uv) {
     ctx->save_for_backward({latent, uv});
+    if (use_cuda_kernels(latent, "sample_latent")) {
 #if defined(TEGA_HAVE_CUDA) && defined(TEGA_TORCH_HAS_CUDA)
-    if (on_cuda(latent)) return latent_sampling::forward_cuda(latent, uv);
+      return latent_sampling::forward_cuda(latent, uv);
 #endif
+    }
     return latent_sampling::forward_cpu(latent, uv);
   }
 
@@ -104,10 +98,13 @@ class SampleLatentFunction : public torch::autograd::Function<SampleLatentFuncti
     const variable_list saved = ctx->get_saved_variables();
     const at::Tensor grad = grads[0].contiguous();
     std::pair<at::Tensor, at::Tensor> g;
+    if (use_cuda_kernels(saved[0], "sample_latent")) {
 #if defined(TEGA_HAVE_CUDA) && defined(TEGA_TORCH_HAS_CUDA)
-    if (on_cuda(saved[0])) g = latent_sampling::backward_cuda(saved[0], saved[1], grad);
+      g = latent_sampling::backward_cuda(saved[0], saved[1], grad);
 #endif
-    if (!on_cuda(saved[0])) g = latent_sampling::backward_cpu(saved[0], saved[1], grad);
+    } else {
+      g = latent_sampling::backward_cpu(saved[0], saved[1], grad);
+    }
     return {g.first, g.second};
   }
 };

@@ -5,17 +5,9 @@
 // u = (c + 0.5)/W, v = 1 - (r + 0.5)/H; outside the outermost centres the
 // coordinate is clamped, and its derivative there is 0.
 
-#if defined(__CUDACC__)
-#ifndef TEGA_HD
-#define TEGA_HD __host__ __device__ __forceinline__
-#endif
-#else
-#ifndef TEGA_HD
-#define TEGA_HD inline
-#endif
-#endif
-
 #include <cstdint>
+
+#include "tega/avatar/host_device.h"
 
 namespace tega::nn::latent_sampling {
 

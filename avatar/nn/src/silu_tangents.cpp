@@ -10,6 +10,7 @@
 
 #include "silu_tangents_glue.h"
 #include "silu_tangents_math.h"
+#include "tega/avatar/device_dispatch.h"
 
 namespace tega::nn {
 namespace silu_tangents {
@@ -64,25 +65,31 @@ namespace {
 using torch::autograd::AutogradContext;
 using torch::autograd::variable_list;
 
-bool on_cuda(const at::Tensor& pre) {
-  if (!pre.is_cuda()) return false;
+std::pair<at::Tensor, at::Tensor> run_forward(const at::Tensor& pre, const at::Tensor& tangents) {
+  if (use_cuda_kernels(pre, "silu_with_tangents")) {
 #if defined(TEGA_HAVE_CUDA) && defined(TEGA_TORCH_HAS_CUDA)
-  return true;
-#else
-  TORCH_CHECK(false, "silu_with_tangents: tensors are on a GPU but this build has no CUDA kernels");
+    return silu_tangents::forward_cuda(pre, tangents);
 #endif
+  }
+  return silu_tangents::forward_cpu(pre, tangents);
+}
+
+std::pair<at::Tensor, at::Tensor> run_backward(const at::Tensor& pre, const at::Tensor& tangents,
+                                               const at::Tensor& grad_value, const at::Tensor& grad_tangents) {
+  if (use_cuda_kernels(pre, "silu_with_tangents")) {
+#if defined(TEGA_HAVE_CUDA) && defined(TEGA_TORCH_HAS_CUDA)
+    return silu_tangents::backward_cuda(pre, tangents, grad_value, grad_tangents);
+#endif
+  }
+  return silu_tangents::backward_cpu(pre, tangents, grad_value, grad_tangents);
 }
 
 class SiluWithTangentsFunction : public torch::autograd::Function<SiluWithTangentsFunction> {
  public:
   static variable_list forward(AutogradContext* ctx, const at::Tensor& pre, const at::Tensor& tangents) {
     ctx->save_for_backward({pre, tangents});
-    std::pair<at::Tensor, at::Tensor> out;
-#if defined(TEGA_HAVE_CUDA) && defined(TEGA_TORCH_HAS_CUDA)
-    if (on_cuda(pre)) out = silu_tangents::forward_cuda(pre, tangents);
-#endif
-    if (!on_cuda(pre)) out = silu_tangents::forward_cpu(pre, tangents);
-    return {out.first, out.second};
+    const auto [value, out] = run_forward(pre, tangents);
+    return {value, out};
   }
 
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
@@ -96,12 +103,8 @@ class SiluWithTangentsFunction : public torch::autograd::Function<SiluWithTangen
       return {at::silu_backward(grad_value, pre), at::Tensor()};
     }
     const at::Tensor grad_tangents = grads[1].contiguous();
-    std::pair<at::Tensor, at::Tensor> g;
-#if defined(TEGA_HAVE_CUDA) && defined(TEGA_TORCH_HAS_CUDA)
-    if (on_cuda(pre)) g = silu_tangents::backward_cuda(pre, tangents, grad_value, grad_tangents);
-#endif
-    if (!on_cuda(pre)) g = silu_tangents::backward_cpu(pre, tangents, grad_value, grad_tangents);
-    return {g.first, g.second};
+    const auto [grad_pre, grad_t] = run_backward(pre, tangents, grad_value, grad_tangents);
+    return {grad_pre, grad_t};
   }
 };
 

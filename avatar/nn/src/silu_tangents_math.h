@@ -7,17 +7,9 @@
 // Forward:  h = silu(x),  u_a = silu'(x) t_a           (a = the three uvd axes)
 // Backward: ∂L/∂x = ∂L/∂h silu'(x) + silu''(x) Σ_a ∂L/∂u_a t_a,  ∂L/∂t_a = ∂L/∂u_a silu'(x)
 
-#if defined(__CUDACC__)
-#ifndef TEGA_HD
-#define TEGA_HD __host__ __device__ __forceinline__
-#endif
-#else
-#ifndef TEGA_HD
-#define TEGA_HD inline
-#endif
-#endif
-
 #include <cmath>
+
+#include "tega/avatar/host_device.h"
 
 namespace tega::nn::silu_tangents {
 

@@ -16,22 +16,7 @@
 //   ∂m/∂μa (at fixed E[a²], E[ab], i.e. through σa² and σab too)
 //             = 2 μb (A2 − A1) / (B1 B2) + 2 μa m (1/B2 − 1/B1).
 
-#if defined(__CUDACC__)
-// Same definitions as tega/splat/gaussian_math.h, so that both may be included.
-#ifndef TEGA_HD
-#define TEGA_HD __host__ __device__ __forceinline__
-#endif
-#ifndef TEGA_UNROLL
-#define TEGA_UNROLL _Pragma("unroll")
-#endif
-#else
-#ifndef TEGA_HD
-#define TEGA_HD inline
-#endif
-#ifndef TEGA_UNROLL
-#define TEGA_UNROLL
-#endif
-#endif
+#include "tega/avatar/host_device.h"
 
 namespace tega::nn::ssim {
 

@@ -9,6 +9,8 @@
 
 #include <string>
 
+#include "tega/avatar/device_dispatch.h"
+
 namespace tega::splat {
 namespace {
 
@@ -17,17 +19,8 @@ using torch::autograd::variable_list;
 
 constexpr double kMinExpectedDepthAlpha = 1e-10;
 
-bool use_cuda_pipeline(const at::Tensor& means) {
-  if (!means.is_cuda()) return false;
-#if defined(TEGA_HAVE_CUDA) && defined(TEGA_TORCH_HAS_CUDA)
-  return true;
-#else
-  TORCH_CHECK(false, "tega splat: tensors are on a GPU but this build has no CUDA kernels");
-#endif
-}
-
 glue::ForwardTensors run_forward(const glue::RasterTensors& t, const glue::CallConfig& config) {
-  if (use_cuda_pipeline(t.means)) {
+  if (use_cuda_kernels(t.means, "tega splat")) {
 #if defined(TEGA_HAVE_CUDA) && defined(TEGA_TORCH_HAS_CUDA)
     return glue::forward_cuda(t, config);
 #endif
@@ -38,7 +31,7 @@ glue::ForwardTensors run_forward(const glue::RasterTensors& t, const glue::CallC
 glue::InputGradTensors run_backward(const glue::RasterTensors& t, const glue::CallConfig& config,
                                     const glue::ForwardTensors& saved, const glue::ImageGradTensors& grads,
                                     const MeanGradientStats* stats) {
-  if (use_cuda_pipeline(t.means)) {
+  if (use_cuda_kernels(t.means, "tega splat")) {
 #if defined(TEGA_HAVE_CUDA) && defined(TEGA_TORCH_HAS_CUDA)
     return glue::backward_cuda(t, config, saved, grads, stats);
 #endif

@@ -7,18 +7,10 @@
 // pixel (0,0) is the centre of the top-left pixel, 3DGS's SH basis and
 // colour = max(SH + 0.5, 0), opacity in [0,1].
 
+#include <cmath>
 #include <cstdint>
 
-#if defined(__CUDACC__)
-#define TEGA_HD __host__ __device__ __forceinline__
-// Fully unrolled loops index register arrays with constants, keeping them
-// out of local memory.
-#define TEGA_UNROLL _Pragma("unroll")
-#else
-#include <cmath>
-#define TEGA_HD inline
-#define TEGA_UNROLL
-#endif
+#include "tega/avatar/host_device.h"
 
 namespace tega::splat {
 
