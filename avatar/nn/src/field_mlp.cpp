@@ -11,8 +11,12 @@ namespace tega::nn {
 namespace {
 
 // Per-axis scale (1, 1, depth_scale), shaped to broadcast against [N,3].
+// Filled on the device: a tensor built from host values would be a copy that
+// waits for the GPU's queue at every call.
 at::Tensor axis_scale(const at::Tensor& uvd, double depth_scale) {
-  return at::tensor({1.0, 1.0, depth_scale}, uvd.options()).view({1, 3});
+  at::Tensor scale = at::ones({1, 3}, uvd.options().requires_grad(false));
+  scale.narrow(1, 2, 1).fill_(depth_scale);
+  return scale;
 }
 
 // π 2^k for k < frequencies, shaped [1,K,1].

@@ -110,7 +110,7 @@ PosedGaussians AvatarModel::pose(const FrameInput& frame, const Eigen::Vector3d&
     const at::Tensor rotation = uvd::rotation_from_quaternion(g.rotation);
     const at::Tensor jacobian_rotation = uvd::batched_matmul(jacobian, rotation);  // [N,3,3]
     const at::Tensor shape = jacobian_rotation * g.log_scale.exp().unsqueeze(1);    // columns scaled by std
-    out.covariances = uvd::packed_gram(shape);
+    out.covariances = uvd::pack_symmetric(uvd::batched_matmul(shape, shape.transpose(1, 2)));
     out.world_std_per_scale = jacobian_rotation.detach().norm(2, 1);
   }
   out.means = means;

@@ -43,13 +43,6 @@ at::Tensor unpack_symmetric(const at::Tensor& packed) {
   return at::stack({c(0), c(1), c(2), c(1), c(3), c(4), c(2), c(4), c(5)}, 1).view({-1, 3, 3});
 }
 
-at::Tensor packed_gram(const at::Tensor& m) {
-  TORCH_CHECK(m.dim() == 3 && m.size(1) == 3, "packed_gram: m must be [N,3,k]");
-  const auto rows = at::tensor({0, 0, 0, 1, 1, 2}, at::TensorOptions(at::kLong).device(m.device()));
-  const auto cols = at::tensor({0, 1, 2, 1, 2, 2}, at::TensorOptions(at::kLong).device(m.device()));
-  return (m.index_select(1, rows) * m.index_select(1, cols)).sum(2);
-}
-
 at::Tensor batched_matmul(const at::Tensor& a, const at::Tensor& b) {
   TORCH_CHECK(a.dim() == 3 && b.dim() == 3 && a.size(2) == b.size(1), "batched_matmul: shapes ", a.sizes(), " and ",
               b.sizes(), " do not multiply");

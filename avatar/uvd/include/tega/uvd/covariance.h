@@ -21,8 +21,6 @@ at::Tensor world_covariance(const at::Tensor& jacobian, const at::Tensor& scale,
 
 at::Tensor pack_symmetric(const at::Tensor& matrix);    // [N,3,3] -> [N,6]
 at::Tensor unpack_symmetric(const at::Tensor& packed);  // [N,6] -> [N,3,3]
-// pack_symmetric(m mᵀ) for m [N,3,k], from the six row products only.
-at::Tensor packed_gram(const at::Tensor& m);
 
 // a [N,i,k] · b [N,k,j] -> [N,i,j] for millions of tiny matrices, as a
 // broadcast product and a sum: a batched GEMM (bmm) spends a whole tile on
