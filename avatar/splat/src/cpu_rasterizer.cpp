@@ -144,7 +144,9 @@ template <typename T>
 void project_backward(const RasterInputs<T>& in, const int32_t* radii, const Splat2D<T>* splat_grads,
                       const InputGradients<T>& out) {
   at::parallel_for(0, in.num_gaussians, 256, [&](int64_t begin, int64_t end) {
-    for (int64_t g = begin; g < end; ++g) project_backward_one(in, radii, splat_grads, g, out);
+    const int64_t row = int64_t(3) * in.sh_coefficients;
+    for (int64_t g = begin; g < end; ++g)
+      project_backward_one(in, radii, splat_grads, g, in.colors + row * g, out.colors + row * g, out);
   });
 }
 

@@ -106,16 +106,19 @@ TEGA_HD int32_t project_one(const RasterInputs<T>& in, int32_t c, int64_t g, Spl
 }
 
 // Backward of project_one for Gaussian g over every camera: reads the splat
-// gradients [C * N] and writes (not adds) all of g's input gradients.
+// gradients [C * N] and writes (not adds) all of g's input gradients. With
+// SH colours, g's coefficients are read from sh_row and their gradient is
+// written to grad_sh_row (g's rows of in.colors and out.colors, or copies of
+// them that the caller moves).
 template <typename T>
 TEGA_HD void project_backward_one(const RasterInputs<T>& in, const int32_t* radii, const Splat2D<T>* splat_grads,
-                                  int64_t g, const InputGradients<T>& out) {
+                                  int64_t g, const T* sh_row, T* grad_sh_row, const InputGradients<T>& out) {
   T grad_mean[3] = {T(0), T(0), T(0)};
   T grad_cov[6] = {T(0), T(0), T(0), T(0), T(0), T(0)};
   T grad_opacity = T(0);
   const int64_t n = in.num_gaussians;
   const bool sh = in.sh_coefficients > 0;
-  T* grad_sh = sh ? out.colors + int64_t(3) * in.sh_coefficients * g : nullptr;
+  T* grad_sh = sh ? grad_sh_row : nullptr;
   bool sh_written = false;  // the first camera writes grad_sh, later ones add
   T grad_rgb_shared[3] = {T(0), T(0), T(0)};
   T stat_norm = T(0);
@@ -137,8 +140,8 @@ TEGA_HD void project_backward_one(const RasterInputs<T>& in, const int32_t* radi
     if (sh) {
       const T direction[3] = {mean[0] - cam.centre[0], mean[1] - cam.centre[1], mean[2] - cam.centre[2]};
       T grad_direction[3];
-      sh_to_rgb_backward(in.sh_degree, in.sh_coefficients, in.colors + int64_t(3) * in.sh_coefficients * g,
-                         direction, grad_rgb, sh_written, grad_sh, grad_direction);
+      sh_to_rgb_backward(in.sh_degree, in.sh_coefficients, sh_row, direction, grad_rgb, sh_written, grad_sh,
+                         grad_direction);
       sh_written = true;
       for (int k = 0; k < 3; ++k) grad_mean[k] += grad_direction[k];
     } else if (in.color_camera_stride == 0) {

@@ -1,6 +1,9 @@
-// CUDA kernels of the tile rasterizer. The per-Gaussian and per-pixel math
-// comes from gaussian_math.h / pipeline.h, shared with the CPU path.
+// CUDA kernels of the tile rasterizer's per-Gaussian stages (projection,
+// depth order, binning, projection backward); the blending is in
+// blending.cu. The math comes from gaussian_math.h / pipeline.h, shared with
+// the CPU path.
 
+#include "cuda_check.h"
 #include "cuda_rasterizer.h"
 
 #include <cub/device/device_radix_sort.cuh>
@@ -8,29 +11,16 @@
 
 #include <climits>
 #include <stdexcept>
-#include <string>
 
 namespace tega::splat::cuda {
 namespace {
 
-void check(cudaError_t status, const char* what) {
-  if (status != cudaSuccess) throw std::runtime_error(std::string("tega splat: ") + what + ": " + cudaGetErrorString(status));
-}
-#define TEGA_CUDA_CHECK(expr) check((expr), #expr)
-#define TEGA_CHECK_LAUNCH(kernel) check(cudaGetLastError(), "launching " #kernel)
-
 constexpr int kThreads = 256;
-static_assert(kTileSize * kTileSize == kThreads, "forward blending: one thread per pixel of a tile");
-// The backward blending gives each thread two pixels of a tile, so that a
-// splat read from shared memory and each warp reduction serve 64 pixels.
-constexpr int kRenderThreads = 128;
-constexpr int kWarpRows = 4;  // a warp covers a 16 x 4 block of its tile
-static_assert(kTileSize * kTileSize == 2 * kRenderThreads, "two pixels per thread");
-static_assert(kTileSize * kWarpRows == 64 && kTileSize * kTileSize / 64 == kRenderThreads / 32,
-              "warps of 64 pixels tile the tile");
-constexpr unsigned kFullWarp = 0xffffffffu;
-
-unsigned grid_for(int64_t n) { return unsigned((n + kThreads - 1) / kThreads); }
+unsigned grid_for(int64_t n, int threads = kThreads) { return unsigned((n + threads - 1) / threads); }
+// project_backward_kernel needs ~160 registers a thread (the SH derivatives):
+// blocks of 256 would leave room for one block, 8 warps, per multiprocessor;
+// blocks of 64 fit six, 12 warps.
+constexpr int kProjectBackwardThreads = 64;
 
 // Bits needed to hold values in [0, count).
 int bits_for(int64_t count) {
@@ -100,194 +90,27 @@ __global__ void tile_ranges_kernel(int64_t count, uint32_t culled, const uint32_
   if (i == count - 1 || sorted_keys[i + 1] != key) ranges[2 * int64_t(key) + 1] = int32_t(i + 1);
 }
 
-struct TilePixel {
-  int64_t tile, pixel;
-  int32_t px, py;
-  bool inside;
-};
-
-__device__ TilePixel tile_pixel(const ImageGeometry& g) {
-  TilePixel t;
-  const int32_t camera = blockIdx.z;
-  t.tile = (int64_t(camera) * g.tiles_y + blockIdx.y) * g.tiles_x + blockIdx.x;
-  t.px = int32_t(blockIdx.x) * kTileSize + int32_t(threadIdx.x % kTileSize);
-  t.py = int32_t(blockIdx.y) * kTileSize + int32_t(threadIdx.x / kTileSize);
-  t.inside = t.px < g.width && t.py < g.height;
-  t.pixel = (int64_t(camera) * g.height + t.py) * g.width + t.px;
-  return t;
-}
-
-// Copies a splat with three 16-byte loads.
-__device__ __forceinline__ void copy_splat(Splat2D<float>& dst, const Splat2D<float>& src) {
-  const float4* s = reinterpret_cast<const float4*>(&src);
-  float4* d = reinterpret_cast<float4*>(&dst);
-  d[0] = s[0];
-  d[1] = s[1];
-  d[2] = s[2];
-}
-
-__global__ void __launch_bounds__(kThreads) render_forward_kernel(RasterInputs<float> in,
-                                                                  const Splat2D<float>* splats, TileBins bins,
-                                                                  ImageBuffers<float> image) {
-  __shared__ Splat2D<float> batch[kThreads];
-  const ImageGeometry g = in.geometry;
-  const TilePixel tp = tile_pixel(g);
-  const int32_t begin = bins.ranges[2 * tp.tile], end = bins.ranges[2 * tp.tile + 1];
-  PixelAccumulator<float> acc;
-  acc.done = !tp.inside;
-  const float px = float(tp.px), py = float(tp.py);
-  for (int32_t start = begin; start < end; start += kThreads) {
-    // Also the barrier that lets this round overwrite the previous batch.
-    if (__syncthreads_count(acc.done) == kThreads) break;
-    const int32_t k = start + int32_t(threadIdx.x);
-    if (k < end) copy_splat(batch[threadIdx.x], splats[bins.gaussian_ids[k]]);
-    __syncthreads();
-    const int32_t count = min(kThreads, end - start);
-    for (int32_t j = 0; j < count && !acc.done; ++j) blend_forward(acc, batch[j], px, py, start - begin + j);
-  }
-  if (!tp.inside) return;
-  const float* bg = in.background;
-  for (int ch = 0; ch < 3; ++ch) image.rgb[3 * tp.pixel + ch] = acc.rgb[ch] + acc.transmittance * bg[ch];
-  image.alpha[tp.pixel] = 1.0f - acc.transmittance;
-  image.depth[tp.pixel] = acc.depth;
-  image.final_transmittance[tp.pixel] = acc.transmittance;
-  image.last[tp.pixel] = acc.last;
-}
-
-// A thread's two pixels: column lane % 16, rows 4w + lane / 16 and two
-// below, for warp w.
-struct TilePixels {
-  int64_t tile;
-  int64_t pixel[2];
-  float px, py[2];
-  bool inside[2];
-};
-
-__device__ TilePixels tile_pixels(const ImageGeometry& g) {
-  TilePixels t;
-  const int32_t camera = blockIdx.z;
-  const int32_t lane = int32_t(threadIdx.x % 32), warp = int32_t(threadIdx.x / 32);
-  t.tile = (int64_t(camera) * g.tiles_y + blockIdx.y) * g.tiles_x + blockIdx.x;
-  const int32_t x = int32_t(blockIdx.x) * kTileSize + lane % kTileSize;
-  t.px = float(x);
-  for (int k = 0; k < 2; ++k) {
-    const int32_t y = int32_t(blockIdx.y) * kTileSize + kWarpRows * warp + lane / kTileSize + 2 * k;
-    t.py[k] = float(y);
-    t.inside[k] = x < g.width && y < g.height;
-    t.pixel[k] = (int64_t(camera) * g.height + y) * g.width + x;
-  }
-  return t;
-}
-
-// Sums the ten gradient fields of a splat over the warp by recursive
-// halving: at each step a lane keeps half of the values it carries and
-// swaps the other half with its partner, 12 shuffles in all (a shuffle tree
-// per field takes 50). On return `total` holds the warp's sum of field
-// number `field` (u, v, opacity, depth, conic a, b, c, red, green, blue);
-// field is -1 where the lane holds none. Lanes 2i and 2i + 1 hold the same.
-__device__ __forceinline__ int warp_reduce_scatter(const Splat2D<float>& grad, float& total) {
-  const unsigned lane = threadIdx.x % 32;
-  const float v[10] = {grad.u,       grad.v,       grad.opacity, grad.depth, grad.conic_a,
-                       grad.conic_b, grad.conic_c, grad.red,     grad.green, grad.blue};
-  const bool h16 = lane & 16, h8 = lane & 8, h4 = lane & 4, h2 = lane & 2;
-  float a[5];  // fields 5·h16 + i
-#pragma unroll
-  for (int i = 0; i < 5; ++i) {
-    const float send = h16 ? v[i] : v[i + 5], keep = h16 ? v[i + 5] : v[i];
-    a[i] = keep + __shfl_xor_sync(kFullWarp, send, 16);
-  }
-  float b[3];  // entries 3·h8 + i of a (the sixth is empty)
-#pragma unroll
-  for (int i = 0; i < 3; ++i) {
-    const float upper = i + 3 < 5 ? a[i + 3] : 0.0f;
-    const float send = h8 ? a[i] : upper, keep = h8 ? upper : a[i];
-    b[i] = keep + __shfl_xor_sync(kFullWarp, send, 8);
-  }
-  float c[2];  // entries 2·h4 + i of b (the fourth is empty)
-#pragma unroll
-  for (int i = 0; i < 2; ++i) {
-    const float upper = i + 2 < 3 ? b[i + 2] : 0.0f;
-    const float send = h4 ? b[i] : upper, keep = h4 ? upper : b[i];
-    c[i] = keep + __shfl_xor_sync(kFullWarp, send, 4);
-  }
-  const float send = h2 ? c[0] : c[1], keep = h2 ? c[1] : c[0];
-  total = keep + __shfl_xor_sync(kFullWarp, send, 2);
-  total += __shfl_xor_sync(kFullWarp, total, 1);
-  const int index_b = (h4 ? 2 : 0) + (h2 ? 1 : 0);
-  const int index_a = (h8 ? 3 : 0) + index_b;
-  return index_b < 3 && index_a < 5 ? (h16 ? 5 : 0) + index_a : -1;
-}
-
-// Offset of gradient field number `field` (warp_reduce_scatter's order) in a Splat2D.
-__device__ __forceinline__ int splat_field_offset(int field) { return field < 7 ? field : field + 1; }
-
-__global__ void __launch_bounds__(kRenderThreads) render_backward_kernel(RasterInputs<float> in,
-                                                                         const Splat2D<float>* splats, TileBins bins,
-                                                                         ImageBuffers<float> image,
-                                                                         ImageGradients<float> grads,
-                                                                         Splat2D<float>* splat_grads) {
-  __shared__ Splat2D<float> batch[kRenderThreads];
-  __shared__ int32_t batch_ids[kRenderThreads];
-  __shared__ int32_t block_last;
-  const ImageGeometry g = in.geometry;
-  const TilePixels tp = tile_pixels(g);
-  const int32_t begin = bins.ranges[2 * tp.tile];
-  const float* bg = in.background;
-
-  PixelBackward<float> st[2];
-  int32_t last[2] = {0, 0};
-  for (int p = 0; p < 2; ++p) {
-    if (!tp.inside[p]) continue;
-    const int64_t pixel = tp.pixel[p];
-    for (int ch = 0; ch < 3; ++ch) st[p].grad_rgb[ch] = grads.rgb[3 * pixel + ch];
-    st[p].grad_alpha_out = grads.alpha[pixel];
-    st[p].grad_depth = grads.depth[pixel];
-    st[p].final_transmittance = image.final_transmittance[pixel];
-    st[p].transmittance = st[p].final_transmittance;
-    st[p].background_dot = bg[0] * st[p].grad_rgb[0] + bg[1] * st[p].grad_rgb[1] + bg[2] * st[p].grad_rgb[2];
-    last[p] = image.last[pixel];
-  }
-  const int32_t warp_last = __reduce_max_sync(kFullWarp, unsigned(max(last[0], last[1])));
-  if (threadIdx.x == 0) block_last = 0;
+// SH rows go through shared memory: a thread's row is 3K consecutive floats,
+// so reading and writing them in place would touch a cache line per thread
+// and value. The block moves its rows with coalesced accesses instead; rows
+// are padded to an odd stride so that the threads' accesses hit distinct banks.
+__global__ void __launch_bounds__(kProjectBackwardThreads) project_backward_kernel(RasterInputs<float> in,
+                                                                                   const int32_t* radii,
+                                                                                   const Splat2D<float>* splat_grads,
+                                                                                   InputGradients<float> out) {
+  extern __shared__ float sh_rows[];  // [2][blockDim.x][stride]: coefficients, then their gradients
+  const int64_t first = int64_t(blockIdx.x) * blockDim.x, g = first + threadIdx.x;
+  const int32_t row = 3 * in.sh_coefficients, stride = row | 1;
+  const int32_t count = int32_t(min(int64_t(blockDim.x), in.num_gaussians - first)) * row;
+  float* sh = sh_rows + threadIdx.x * stride;
+  float* grad_sh = sh + blockDim.x * stride;
+  for (int32_t e = threadIdx.x; e < count; e += blockDim.x)
+    sh_rows[e / row * stride + e % row] = in.colors[first * row + e];
   __syncthreads();
-  if (threadIdx.x % 32 == 0) atomicMax(&block_last, warp_last);
+  if (g < in.num_gaussians) project_backward_one(in, radii, splat_grads, g, sh, grad_sh, out);
   __syncthreads();
-
-  // Back to front, in batches loaded from the end of the tile's run.
-  for (int32_t stop = begin + block_last; stop > begin; stop -= kRenderThreads) {
-    const int32_t start = max(begin, stop - kRenderThreads);
-    __syncthreads();
-    const int32_t k = stop - 1 - int32_t(threadIdx.x);
-    if (k >= start) {
-      const int32_t id = bins.gaussian_ids[k];
-      batch_ids[threadIdx.x] = id;
-      copy_splat(batch[threadIdx.x], splats[id]);
-    }
-    __syncthreads();
-    const int32_t count = stop - start;
-    // batch[j] is entry stop - 1 - j - begin of the tile; the warp's pixels
-    // blended only entries below warp_last.
-    for (int32_t j = max(0, stop - begin - warp_last); j < count; ++j) {
-      const int32_t index_in_tile = stop - 1 - j - begin;
-      Splat2D<float> sp;
-      copy_splat(sp, batch[j]);
-      Splat2D<float> local{};
-      bool contributed = false;
-      if (index_in_tile < last[0]) contributed |= blend_backward(st[0], sp, tp.px, tp.py[0], local);
-      if (index_in_tile < last[1]) contributed |= blend_backward(st[1], sp, tp.px, tp.py[1], local);
-      if (!__any_sync(kFullWarp, contributed)) continue;
-      float total;
-      const int field = warp_reduce_scatter(local, total);
-      if (field >= 0 && (threadIdx.x & 1) == 0)
-        atomicAdd(reinterpret_cast<float*>(&splat_grads[batch_ids[j]]) + splat_field_offset(field), total);
-    }
-  }
-}
-
-__global__ void project_backward_kernel(RasterInputs<float> in, const int32_t* radii,
-                                        const Splat2D<float>* splat_grads, InputGradients<float> out) {
-  const int64_t g = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
-  if (g < in.num_gaussians) project_backward_one(in, radii, splat_grads, g, out);
+  for (int32_t e = threadIdx.x; e < count; e += blockDim.x)
+    out.colors[first * row + e] = sh_rows[(blockDim.x + e / row) * stride + e % row];
 }
 
 }  // namespace
@@ -361,27 +184,13 @@ void bin(const RasterInputs<float>& in, const ProjectedBuffers<float>& projected
   TEGA_CHECK_LAUNCH(tile_ranges_kernel);
 }
 
-void render_forward(const RasterInputs<float>& in, const Splat2D<float>* splats, const TileBins& bins,
-                    const ImageBuffers<float>& image, cudaStream_t stream) {
-  if (in.num_pixels() == 0) return;
-  const dim3 grid(in.geometry.tiles_x, in.geometry.tiles_y, in.num_cameras);
-  render_forward_kernel<<<grid, kThreads, 0, stream>>>(in, splats, bins, image);
-  TEGA_CHECK_LAUNCH(render_forward_kernel);
-}
-
-void render_backward(const RasterInputs<float>& in, const Splat2D<float>* splats, const TileBins& bins,
-                     const ImageBuffers<float>& image, const ImageGradients<float>& grads,
-                     Splat2D<float>* splat_grads, cudaStream_t stream) {
-  if (in.num_pixels() == 0) return;
-  const dim3 grid(in.geometry.tiles_x, in.geometry.tiles_y, in.num_cameras);
-  render_backward_kernel<<<grid, kRenderThreads, 0, stream>>>(in, splats, bins, image, grads, splat_grads);
-  TEGA_CHECK_LAUNCH(render_backward_kernel);
-}
-
 void project_backward(const RasterInputs<float>& in, const int32_t* radii, const Splat2D<float>* splat_grads,
                       const InputGradients<float>& out, cudaStream_t stream) {
   if (in.num_gaussians == 0) return;
-  project_backward_kernel<<<grid_for(in.num_gaussians), kThreads, 0, stream>>>(in, radii, splat_grads, out);
+  const int32_t sh_stride = in.sh_coefficients > 0 ? (3 * in.sh_coefficients) | 1 : 0;
+  const std::size_t shared_bytes = 2 * kProjectBackwardThreads * sh_stride * sizeof(float);
+  project_backward_kernel<<<grid_for(in.num_gaussians, kProjectBackwardThreads), kProjectBackwardThreads,
+                            shared_bytes, stream>>>(in, radii, splat_grads, out);
   TEGA_CHECK_LAUNCH(project_backward_kernel);
 }
 

@@ -1,0 +1,361 @@
+// CUDA kernels of the per-tile blending, forward and backward. They compute
+// what blend_forward / blend_backward (gaussian_math.h) compute on the CPU,
+// in a form that costs fewer instructions per pixel and splat, the unit
+// both kernels are bound by (docs/rasterizer.md, "Blending on CUDA").
+
+#include "cuda_check.h"
+#include "cuda_rasterizer.h"
+
+namespace tega::splat::cuda {
+namespace {
+
+constexpr int kForwardThreads = kTileSize * kTileSize;  // one pixel each
+// The backward pass gives each thread two pixels, so that a splat read from
+// shared memory and each warp reduction serve 64 pixels.
+constexpr int kBackwardThreads = kTileSize * kTileSize / 2;
+constexpr unsigned kFullWarp = 0xffffffffu;
+constexpr float kLog2e = 1.4426950408889634f;
+constexpr float kLn2 = 0.6931471805599453f;
+
+// A splat as the blending loops read it: the Gaussian is 2^p with
+//   p = a dx² + b dx dy + c dy²,  (a, b, c) = -log2(e) (½ conic_a, conic_b, ½ conic_c),
+// so one ex2 instruction evaluates it, and the kMinAlpha test becomes
+// p ≥ cutoff = log2(kMinAlpha / opacity), made before the exponential: most
+// splats of a tile miss most of its pixels. Both kernels evaluate p with
+// blend_exponent(), so the backward pass skips exactly what the forward
+// pass skipped.
+struct alignas(16) BlendSplat {
+  float u, v, a, b;
+  float c, opacity, cutoff, depth;
+  float red, green, blue, unused;
+};
+
+__device__ __forceinline__ Splat2D<float> load_splat(const Splat2D<float>* src) {
+  const float4* s = reinterpret_cast<const float4*>(src);
+  Splat2D<float> sp;
+  float4* d = reinterpret_cast<float4*>(&sp);
+  d[0] = __ldg(s);
+  d[1] = __ldg(s + 1);
+  d[2] = __ldg(s + 2);
+  return sp;
+}
+
+__device__ __forceinline__ BlendSplat blend_splat(const Splat2D<float>& sp) {
+  return {sp.u,
+          sp.v,
+          -0.5f * kLog2e * sp.conic_a,
+          -kLog2e * sp.conic_b,
+          -0.5f * kLog2e * sp.conic_c,
+          sp.opacity,
+          log2f(float(kMinAlpha) / sp.opacity),
+          sp.depth,
+          sp.red,
+          sp.green,
+          sp.blue,
+          0.0f};
+}
+
+__device__ __forceinline__ float exp2_approx(float x) {
+  float y;
+  asm("ex2.approx.ftz.f32 %0, %1;" : "=f"(y) : "f"(x));
+  return y;
+}
+
+// p of the splat at offset (dx, dy) from its mean; a_dx_b_dy = a dx + b dy and
+// c_dy = c dy are kept for the backward pass.
+struct Exponent {
+  float p, a_dx_b_dy, c_dy;
+};
+__device__ __forceinline__ Exponent blend_exponent(const BlendSplat& s, float dx, float dy) {
+  Exponent e;
+  e.a_dx_b_dy = fmaf(s.a, dx, s.b * dy);
+  e.c_dy = s.c * dy;
+  e.p = fmaf(dx, e.a_dx_b_dy, e.c_dy * dy);
+  return e;
+}
+
+// Whether the splat may reach a pixel of the band of `rows` rows from y0 of
+// tile column tx, inside the image (the ellipse test that bins splats to
+// tiles, at the size of the band a warp blends).
+__device__ __forceinline__ bool band_may_touch(const Splat2D<float>& sp, const ImageGeometry& g, int32_t tx, int32_t y0,
+                                               int32_t rows) {
+  const int32_t x0 = tx * kTileSize, x1 = min(x0 + kTileSize - 1, g.width - 1);
+  const int32_t y1 = min(y0 + rows - 1, g.height - 1);
+  return y0 < g.height && splat_may_touch(sp, splat_level(sp), float(x0), float(y0), float(x1), float(y1));
+}
+
+__device__ __forceinline__ int64_t block_tile(const ImageGeometry& g) {
+  return (int64_t(blockIdx.z) * g.tiles_y + blockIdx.y) * g.tiles_x + blockIdx.x;
+}
+
+// Thread t blends pixel (t % 16, t / 16) of its tile: warp w owns rows 2w
+// and 2w + 1. Each warp walks the tile's list on its own, 32 entries at a
+// time: it loads them, keeps those its band may use, and stops when its
+// pixels are done. Warps never wait for each other (with a batch shared by
+// the block, a fifth of the time went to barriers: the warps' work differs).
+__global__ void __launch_bounds__(kForwardThreads) render_forward_kernel(RasterInputs<float> in,
+                                                                         const Splat2D<float>* splats, TileBins bins,
+                                                                         ImageBuffers<float> image) {
+  constexpr int kWarps = kForwardThreads / 32, kBandRows = kTileSize / kWarps;
+  __shared__ BlendSplat batches[kWarps][32];
+  const ImageGeometry g = in.geometry;
+  const int64_t tile = block_tile(g);
+  const unsigned lane = threadIdx.x % 32, warp = threadIdx.x / 32;
+  BlendSplat* batch = batches[warp];
+  const int32_t x = int32_t(blockIdx.x) * kTileSize + int32_t(threadIdx.x % kTileSize);
+  const int32_t y = int32_t(blockIdx.y) * kTileSize + int32_t(threadIdx.x / kTileSize);
+  const int32_t band_y0 = int32_t(blockIdx.y) * kTileSize + kBandRows * int32_t(warp);
+  const bool inside = x < g.width && y < g.height;
+  const float px = float(x), py = float(y);
+  const int32_t begin = bins.ranges[2 * tile], end = bins.ranges[2 * tile + 1];
+
+  float transmittance = 1.0f, red = 0.0f, green = 0.0f, blue = 0.0f, depth = 0.0f;
+  int32_t last = 0;
+  bool done = !inside;
+  for (int32_t start = begin; start < end && !__all_sync(kFullWarp, done); start += 32) {
+    const int32_t k = start + int32_t(lane);
+    bool used = false;
+    if (k < end) {
+      const Splat2D<float> sp = load_splat(splats + bins.gaussian_ids[k]);
+      used = band_may_touch(sp, g, blockIdx.x, band_y0, kBandRows);
+      if (used) batch[lane] = blend_splat(sp);
+    }
+    uint32_t pending = __ballot_sync(kFullWarp, used);
+    __syncwarp();
+    while (pending) {
+      const int32_t j = __ffs(pending) - 1;
+      pending &= pending - 1;
+      if (done) continue;
+      const BlendSplat s = batch[j];
+      const Exponent e = blend_exponent(s, px - s.u, py - s.v);
+      if (e.p < s.cutoff) continue;
+      const float alpha = fminf(float(kMaxAlpha), s.opacity * exp2_approx(e.p));
+      const float next = transmittance * (1.0f - alpha);
+      if (next < float(kMinTransmittance)) {
+        done = true;
+        continue;
+      }
+      const float w = alpha * transmittance;
+      red = fmaf(w, s.red, red);
+      green = fmaf(w, s.green, green);
+      blue = fmaf(w, s.blue, blue);
+      depth = fmaf(w, s.depth, depth);
+      transmittance = next;
+      last = start - begin + j + 1;
+    }
+    __syncwarp();  // the batch is read before the next round overwrites it
+  }
+  if (!inside) return;
+  const int64_t pixel = (int64_t(blockIdx.z) * g.height + y) * g.width + x;
+  const float* bg = in.background;
+  image.rgb[3 * pixel] = red + transmittance * bg[0];
+  image.rgb[3 * pixel + 1] = green + transmittance * bg[1];
+  image.rgb[3 * pixel + 2] = blue + transmittance * bg[2];
+  image.alpha[pixel] = 1.0f - transmittance;
+  image.depth[pixel] = depth;
+  image.final_transmittance[pixel] = transmittance;
+  image.last[pixel] = last;
+}
+
+// One pixel of the backward walk, back to front (PixelBackward's fields, with
+// the final-transmittance term folded into one number).
+struct PixelState {
+  float grad_rgb[3], grad_depth;
+  float final_term;  // T_final (dL/dalpha_out - background · dL/drgb)
+  float transmittance;
+  float behind_rgb[3], behind_depth;
+};
+
+// Gradient fields of one splat summed over a thread's pixels, in
+// warp_reduce_scatter's order. The shape terms are in the units that cost
+// least per pixel; kFieldScale turns the warp's totals into d loss / d field.
+enum Field { kU, kV, kOpacity, kDepth, kConicA, kConicB, kConicC, kRed, kGreen, kBlue, kFields };
+__device__ constexpr float kFieldScale[kFields] = {-kLn2, -kLn2, 1.0f, 1.0f, -0.5f, -1.0f, -0.5f, 1.0f, 1.0f, 1.0f};
+// Offset of each field in a Splat2D (which has a gap after conic_c).
+__device__ __forceinline__ int splat_field_offset(int field) { return field < kRed ? field : field + 1; }
+
+// Adds splat s's gradient at one pixel to `grad` and steps the pixel's state
+// to the splat's front. False when the pixel skipped the splat.
+__device__ __forceinline__ bool blend_backward_pixel(PixelState& st, const BlendSplat& s, float px, float py,
+                                                     float (&grad)[kFields]) {
+  const float dx = px - s.u, dy = py - s.v;
+  const Exponent e = blend_exponent(s, dx, dy);
+  if (e.p < s.cutoff) return false;
+  const float gaussian = exp2_approx(e.p);
+  const float raw_alpha = s.opacity * gaussian;
+  const float alpha = fminf(float(kMaxAlpha), raw_alpha);
+  const float inv_one_minus = __fdividef(1.0f, 1.0f - alpha);
+  st.transmittance *= inv_one_minus;  // T in front of this splat
+  const float t = st.transmittance, w = alpha * t;
+  grad[kRed] = fmaf(w, st.grad_rgb[0], grad[kRed]);
+  grad[kGreen] = fmaf(w, st.grad_rgb[1], grad[kGreen]);
+  grad[kBlue] = fmaf(w, st.grad_rgb[2], grad[kBlue]);
+  grad[kDepth] = fmaf(w, st.grad_depth, grad[kDepth]);
+  const float d_red = s.red - st.behind_rgb[0], d_green = s.green - st.behind_rgb[1];
+  const float d_blue = s.blue - st.behind_rgb[2], d_depth = s.depth - st.behind_depth;
+  float grad_alpha = d_red * st.grad_rgb[0];
+  grad_alpha = fmaf(d_green, st.grad_rgb[1], grad_alpha);
+  grad_alpha = fmaf(d_blue, st.grad_rgb[2], grad_alpha);
+  grad_alpha = fmaf(d_depth, st.grad_depth, grad_alpha);
+  grad_alpha = fmaf(grad_alpha, t, st.final_term * inv_one_minus);
+  st.behind_rgb[0] = fmaf(alpha, d_red, st.behind_rgb[0]);
+  st.behind_rgb[1] = fmaf(alpha, d_green, st.behind_rgb[1]);
+  st.behind_rgb[2] = fmaf(alpha, d_blue, st.behind_rgb[2]);
+  st.behind_depth = fmaf(alpha, d_depth, st.behind_depth);
+  if (raw_alpha > float(kMaxAlpha)) return true;  // clamped: no gradient to opacity or shape
+  grad[kOpacity] = fmaf(gaussian, grad_alpha, grad[kOpacity]);
+  // d loss / d power, power = p ln 2 the natural exponent; its derivatives
+  // w.r.t. (u, v) are -ln2 (2a dx + b dy, b dx + 2c dy) and w.r.t. the conic
+  // -(½ dx², dx dy, ½ dy²): the constant factors wait for kFieldScale.
+  const float grad_power = raw_alpha * grad_alpha;
+  grad[kU] = fmaf(grad_power, fmaf(s.a, dx, e.a_dx_b_dy), grad[kU]);
+  grad[kV] = fmaf(grad_power, fmaf(s.b, dx, 2.0f * e.c_dy), grad[kV]);
+  const float grad_power_dx = grad_power * dx;
+  grad[kConicA] = fmaf(grad_power_dx, dx, grad[kConicA]);
+  grad[kConicB] = fmaf(grad_power_dx, dy, grad[kConicB]);
+  grad[kConicC] = fmaf(grad_power * dy, dy, grad[kConicC]);
+  return true;
+}
+
+// The field whose warp total warp_reduce_scatter leaves in this lane, or -1.
+// Lanes 2i and 2i + 1 hold the same.
+__device__ __forceinline__ int reduced_field(unsigned lane) {
+  const int index_b = ((lane & 4) ? 2 : 0) + ((lane & 2) ? 1 : 0);
+  const int index_a = ((lane & 8) ? 3 : 0) + index_b;
+  return index_b < 3 && index_a < 5 ? ((lane & 16) ? 5 : 0) + index_a : -1;
+}
+
+// Sums the ten fields over the warp by recursive halving: at each step a
+// lane keeps half of the values it carries and swaps the other half with
+// its partner, 12 shuffles in all (a shuffle tree per field takes 50).
+// Returns the total of field reduced_field(lane).
+__device__ __forceinline__ float warp_reduce_scatter(const float (&v)[kFields]) {
+  const unsigned lane = threadIdx.x % 32;
+  const bool h16 = lane & 16, h8 = lane & 8, h4 = lane & 4, h2 = lane & 2;
+  float a[5];  // fields 5·h16 + i
+#pragma unroll
+  for (int i = 0; i < 5; ++i) {
+    const float send = h16 ? v[i] : v[i + 5], keep = h16 ? v[i + 5] : v[i];
+    a[i] = keep + __shfl_xor_sync(kFullWarp, send, 16);
+  }
+  float b[3];  // entries 3·h8 + i of a (the sixth is empty)
+#pragma unroll
+  for (int i = 0; i < 3; ++i) {
+    const float upper = i + 3 < 5 ? a[i + 3] : 0.0f;
+    const float send = h8 ? a[i] : upper, keep = h8 ? upper : a[i];
+    b[i] = keep + __shfl_xor_sync(kFullWarp, send, 8);
+  }
+  float c[2];  // entries 2·h4 + i of b (the fourth is empty)
+#pragma unroll
+  for (int i = 0; i < 2; ++i) {
+    const float upper = i + 2 < 3 ? b[i + 2] : 0.0f;
+    const float send = h4 ? b[i] : upper, keep = h4 ? upper : b[i];
+    c[i] = keep + __shfl_xor_sync(kFullWarp, send, 4);
+  }
+  const float send = h2 ? c[0] : c[1], keep = h2 ? c[1] : c[0];
+  float total = keep + __shfl_xor_sync(kFullWarp, send, 2);
+  return total + __shfl_xor_sync(kFullWarp, total, 1);
+}
+
+// Thread t of warp w blends column t % 16 of rows 4w + t / 16 and 4w + t / 16 + 2:
+// warp w owns rows [4w, 4w + 4) of the tile. Like the forward pass, each warp
+// walks the list on its own, from the last entry its pixels blended.
+__global__ void __launch_bounds__(kBackwardThreads) render_backward_kernel(RasterInputs<float> in,
+                                                                           const Splat2D<float>* splats,
+                                                                           TileBins bins, ImageBuffers<float> image,
+                                                                           ImageGradients<float> grads,
+                                                                           Splat2D<float>* splat_grads) {
+  constexpr int kWarps = kBackwardThreads / 32, kBandRows = kTileSize / kWarps;
+  __shared__ BlendSplat batches[kWarps][32];
+  __shared__ int32_t batch_ids[kWarps][32];
+  const ImageGeometry g = in.geometry;
+  const int64_t tile = block_tile(g);
+  const int32_t begin = bins.ranges[2 * tile];
+  const unsigned lane = threadIdx.x % 32, warp = threadIdx.x / 32;
+  BlendSplat* batch = batches[warp];
+  int32_t* ids = batch_ids[warp];
+  const int32_t x = int32_t(blockIdx.x) * kTileSize + int32_t(lane % kTileSize);
+  const int32_t band_y0 = int32_t(blockIdx.y) * kTileSize + kBandRows * int32_t(warp);
+  const float px = float(x);
+  const float* bg = in.background;
+
+  PixelState st[2];
+  float py[2];
+  int32_t last[2] = {0, 0};
+#pragma unroll
+  for (int p = 0; p < 2; ++p) {
+    const int32_t y = band_y0 + int32_t(lane / kTileSize) + 2 * p;
+    py[p] = float(y);
+    float grad_alpha_out = 0.0f, final_transmittance = 0.0f;
+    st[p] = {};
+    if (x < g.width && y < g.height) {
+      const int64_t pixel = (int64_t(blockIdx.z) * g.height + y) * g.width + x;
+      for (int ch = 0; ch < 3; ++ch) st[p].grad_rgb[ch] = grads.rgb[3 * pixel + ch];
+      st[p].grad_depth = grads.depth[pixel];
+      grad_alpha_out = grads.alpha[pixel];
+      final_transmittance = image.final_transmittance[pixel];
+      last[p] = image.last[pixel];
+    }
+    const float background_dot = bg[0] * st[p].grad_rgb[0] + bg[1] * st[p].grad_rgb[1] + bg[2] * st[p].grad_rgb[2];
+    st[p].final_term = final_transmittance * (grad_alpha_out - background_dot);
+    st[p].transmittance = final_transmittance;
+  }
+  const int field = reduced_field(lane);
+  const bool writes = field >= 0 && (lane & 1) == 0;
+  const int field_offset = writes ? splat_field_offset(field) : 0;
+  const float field_scale = writes ? kFieldScale[field] : 0.0f;
+  const int32_t warp_last = int32_t(__reduce_max_sync(kFullWarp, unsigned(max(last[0], last[1]))));
+
+  // Back to front: lane l loads entry stop - 1 - l, so batch[j] is entry
+  // stop - 1 - j of the tile.
+  for (int32_t stop = begin + warp_last; stop > begin; stop -= 32) {
+    const int32_t k = stop - 1 - int32_t(lane);
+    bool used = false;
+    if (k >= begin) {
+      const int32_t id = bins.gaussian_ids[k];
+      const Splat2D<float> sp = load_splat(splats + id);
+      used = band_may_touch(sp, g, blockIdx.x, band_y0, kBandRows);
+      if (used) {
+        batch[lane] = blend_splat(sp);
+        ids[lane] = id;
+      }
+    }
+    uint32_t pending = __ballot_sync(kFullWarp, used);
+    __syncwarp();
+    while (pending) {
+      const int32_t j = __ffs(pending) - 1;
+      pending &= pending - 1;
+      const int32_t index_in_tile = stop - 1 - j - begin;
+      const BlendSplat s = batch[j];
+      float grad[kFields] = {};
+      bool contributed = false;
+      if (index_in_tile < last[0]) contributed |= blend_backward_pixel(st[0], s, px, py[0], grad);
+      if (index_in_tile < last[1]) contributed |= blend_backward_pixel(st[1], s, px, py[1], grad);
+      if (!__any_sync(kFullWarp, contributed)) continue;
+      const float total = warp_reduce_scatter(grad);
+      if (writes) atomicAdd(reinterpret_cast<float*>(&splat_grads[ids[j]]) + field_offset, total * field_scale);
+    }
+    __syncwarp();  // the batch is read before the next round overwrites it
+  }
+}
+
+}  // namespace
+
+void render_forward(const RasterInputs<float>& in, const Splat2D<float>* splats, const TileBins& bins,
+                    const ImageBuffers<float>& image, cudaStream_t stream) {
+  if (in.num_pixels() == 0) return;
+  const dim3 grid(in.geometry.tiles_x, in.geometry.tiles_y, in.num_cameras);
+  render_forward_kernel<<<grid, kForwardThreads, 0, stream>>>(in, splats, bins, image);
+  TEGA_CHECK_LAUNCH(render_forward_kernel);
+}
+
+void render_backward(const RasterInputs<float>& in, const Splat2D<float>* splats, const TileBins& bins,
+                     const ImageBuffers<float>& image, const ImageGradients<float>& grads,
+                     Splat2D<float>* splat_grads, cudaStream_t stream) {
+  if (in.num_pixels() == 0) return;
+  const dim3 grid(in.geometry.tiles_x, in.geometry.tiles_y, in.num_cameras);
+  render_backward_kernel<<<grid, kBackwardThreads, 0, stream>>>(in, splats, bins, image, grads, splat_grads);
+  TEGA_CHECK_LAUNCH(render_backward_kernel);
+}
+
+}  // namespace tega::splat::cuda
