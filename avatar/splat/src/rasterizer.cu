@@ -17,10 +17,11 @@ namespace {
 
 constexpr int kThreads = 256;
 unsigned grid_for(int64_t n, int threads = kThreads) { return unsigned((n + threads - 1) / threads); }
-// project_backward_kernel needs ~160 registers a thread (the SH derivatives):
-// blocks of 256 would leave room for one block, 8 warps, per multiprocessor;
-// blocks of 64 fit six, 12 warps.
+// project_backward_kernel needs over 100 registers a thread (the projection's
+// and the SH's derivatives): small blocks waste none of a multiprocessor's
+// register file, and nine of them (18 warps) fit its shared memory.
 constexpr int kProjectBackwardThreads = 64;
+constexpr int kProjectBackwardBlocks = 9;
 
 // Bits needed to hold values in [0, count).
 int bits_for(int64_t count) {
@@ -94,10 +95,9 @@ __global__ void tile_ranges_kernel(int64_t count, uint32_t culled, const uint32_
 // so reading and writing them in place would touch a cache line per thread
 // and value. The block moves its rows with coalesced accesses instead; rows
 // are padded to an odd stride so that the threads' accesses hit distinct banks.
-__global__ void __launch_bounds__(kProjectBackwardThreads) project_backward_kernel(RasterInputs<float> in,
-                                                                                   const int32_t* radii,
-                                                                                   const Splat2D<float>* splat_grads,
-                                                                                   InputGradients<float> out) {
+__global__ void __launch_bounds__(kProjectBackwardThreads, kProjectBackwardBlocks)
+    project_backward_kernel(RasterInputs<float> in, const int32_t* radii, const Splat2D<float>* splat_grads,
+                            InputGradients<float> out) {
   extern __shared__ float sh_rows[];  // [2][blockDim.x][stride]: coefficients, then their gradients
   const int64_t first = int64_t(blockIdx.x) * blockDim.x, g = first + threadIdx.x;
   const int32_t row = 3 * in.sh_coefficients, stride = row | 1;

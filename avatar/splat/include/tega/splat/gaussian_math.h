@@ -167,30 +167,35 @@ TEGA_HD void set_constant(Dual3<T>& out, T value) {
   out = {value, {T(0), T(0), T(0)}};
 }
 
-// Writes (degree+1)² basis values for the unit direction (x, y, z).
-template <typename T, typename S>
-TEGA_HD void sh_basis(int degree, S x, S y, S z, S* out) {
-  set_constant(out[0], T(0.28209479177387814));
+// Calls visit(b, Y_b) for the (degree+1)² basis functions Y_b at the unit
+// direction (x, y, z), in order. A visitor that consumes each value at once
+// keeps few of them alive: with Dual3 values, an array of all sixteen takes
+// 64 registers a thread on the GPU.
+template <typename T, typename S, typename Visit>
+TEGA_HD void visit_sh_basis(int degree, S x, S y, S z, Visit&& visit) {
+  S constant;
+  set_constant(constant, T(0.28209479177387814));
+  visit(0, constant);
   if (degree < 1) return;
   const T c1 = T(0.4886025119029199);
-  out[1] = T(-c1) * y;
-  out[2] = c1 * z;
-  out[3] = T(-c1) * x;
+  visit(1, T(-c1) * y);
+  visit(2, c1 * z);
+  visit(3, T(-c1) * x);
   if (degree < 2) return;
-  const S xx = x * x, yy = y * y, zz = z * z, xy = x * y, yz = y * z, xz = x * z;
-  out[4] = T(1.0925484305920792) * xy;
-  out[5] = T(-1.0925484305920792) * yz;
-  out[6] = T(0.31539156525252005) * (T(2) * zz - xx - yy);
-  out[7] = T(-1.0925484305920792) * xz;
-  out[8] = T(0.5462742152960396) * (xx - yy);
+  const S xx = x * x, yy = y * y, zz = z * z, xy = x * y;
+  visit(4, T(1.0925484305920792) * xy);
+  visit(5, T(-1.0925484305920792) * (y * z));
+  visit(6, T(0.31539156525252005) * (T(2) * zz - xx - yy));
+  visit(7, T(-1.0925484305920792) * (x * z));
+  visit(8, T(0.5462742152960396) * (xx - yy));
   if (degree < 3) return;
-  out[9] = T(-0.5900435899266435) * y * (T(3) * xx - yy);
-  out[10] = T(2.890611442640554) * xy * z;
-  out[11] = T(-0.4570457994644658) * y * (T(4) * zz - xx - yy);
-  out[12] = T(0.3731763325901154) * z * (T(2) * zz - T(3) * xx - T(3) * yy);
-  out[13] = T(-0.4570457994644658) * x * (T(4) * zz - xx - yy);
-  out[14] = T(1.445305721320277) * z * (xx - yy);
-  out[15] = T(-0.5900435899266435) * x * (xx - T(3) * yy);
+  visit(9, T(-0.5900435899266435) * y * (T(3) * xx - yy));
+  visit(10, T(2.890611442640554) * xy * z);
+  visit(11, T(-0.4570457994644658) * y * (T(4) * zz - xx - yy));
+  visit(12, T(0.3731763325901154) * z * (T(2) * zz - T(3) * xx - T(3) * yy));
+  visit(13, T(-0.4570457994644658) * x * (T(4) * zz - xx - yy));
+  visit(14, T(1.445305721320277) * z * (xx - yy));
+  visit(15, T(-0.5900435899266435) * x * (xx - T(3) * yy));
 }
 
 // Colour of one Gaussian seen along `direction` (camera centre -> mean, not
@@ -200,14 +205,10 @@ TEGA_HD void sh_to_rgb(int degree, const T* sh, const T* direction, T* rgb) {
   const T norm = math_sqrt(direction[0] * direction[0] + direction[1] * direction[1] +
                            direction[2] * direction[2]);
   const T inv = norm > T(0) ? T(1) / norm : T(0);
-  T basis[kMaxShCoefficients];
-  sh_basis<T, T>(degree, direction[0] * inv, direction[1] * inv, direction[2] * inv, basis);
-  const int count = (degree + 1) * (degree + 1);
   T sum[3] = {T(0.5), T(0.5), T(0.5)};
-  TEGA_UNROLL
-  for (int b = 0; b < kMaxShCoefficients; ++b)
-    if (b < count)
-      for (int ch = 0; ch < 3; ++ch) sum[ch] += basis[b] * sh[3 * b + ch];
+  visit_sh_basis<T, T>(degree, direction[0] * inv, direction[1] * inv, direction[2] * inv, [&](int b, T value) {
+    for (int ch = 0; ch < 3; ++ch) sum[ch] += value * sh[3 * b + ch];
+  });
   for (int ch = 0; ch < 3; ++ch) rgb[ch] = math_max(sum[ch], T(0));
 }
 
@@ -227,30 +228,27 @@ TEGA_HD void sh_to_rgb_backward(int degree, int coefficients, const T* sh, const
   }
   const T inv = T(1) / norm;
   const T unit[3] = {direction[0] * inv, direction[1] * inv, direction[2] * inv};
-  Dual3<T> x{unit[0], {T(1), T(0), T(0)}}, y{unit[1], {T(0), T(1), T(0)}}, z{unit[2], {T(0), T(0), T(1)}};
-  Dual3<T> basis[kMaxShCoefficients];
-  sh_basis<T, Dual3<T>>(degree, x, y, z, basis);
-  const int count = (degree + 1) * (degree + 1);
+  // Which channels the clamp passes needs the whole sum, so the basis is
+  // evaluated twice: plainly for the sum, then with its derivatives.
   T sum[3] = {T(0.5), T(0.5), T(0.5)};
-  TEGA_UNROLL
-  for (int b = 0; b < kMaxShCoefficients; ++b)
-    if (b < count)
-      for (int ch = 0; ch < 3; ++ch) sum[ch] += basis[b].v * sh[3 * b + ch];
+  visit_sh_basis<T, T>(degree, unit[0], unit[1], unit[2], [&](int b, T value) {
+    for (int ch = 0; ch < 3; ++ch) sum[ch] += value * sh[3 * b + ch];
+  });
   T grad_pass[3];
   for (int ch = 0; ch < 3; ++ch) grad_pass[ch] = sum[ch] < T(0) ? T(0) : grad_rgb[ch];
   T grad_unit[3] = {T(0), T(0), T(0)};
-  TEGA_UNROLL
-  for (int b = 0; b < kMaxShCoefficients; ++b) {
-    if (b >= coefficients) break;
-    const bool used = b < count;
+  const Dual3<T> x{unit[0], {T(1), T(0), T(0)}}, y{unit[1], {T(0), T(1), T(0)}}, z{unit[2], {T(0), T(0), T(1)}};
+  visit_sh_basis<T, Dual3<T>>(degree, x, y, z, [&](int b, const Dual3<T>& value) {
+    if (b >= coefficients) return;
     for (int ch = 0; ch < 3; ++ch) {
-      const T value = used ? basis[b].v * grad_pass[ch] : T(0);
-      grad_sh[3 * b + ch] = accumulate ? grad_sh[3 * b + ch] + value : value;
+      const T g = value.v * grad_pass[ch];
+      grad_sh[3 * b + ch] = accumulate ? grad_sh[3 * b + ch] + g : g;
     }
-    if (!used) continue;
     const T weight = grad_pass[0] * sh[3 * b] + grad_pass[1] * sh[3 * b + 1] + grad_pass[2] * sh[3 * b + 2];
-    for (int k = 0; k < 3; ++k) grad_unit[k] += weight * basis[b].d[k];
-  }
+    for (int k = 0; k < 3; ++k) grad_unit[k] += weight * value.d[k];
+  });
+  if (!accumulate)  // stored coefficients of higher degrees than evaluated
+    for (int k = 3 * (degree + 1) * (degree + 1); k < 3 * coefficients; ++k) grad_sh[k] = T(0);
   // d unit / d direction = (I - unit unitᵀ) / norm
   const T along = grad_unit[0] * unit[0] + grad_unit[1] * unit[1] + grad_unit[2] * unit[2];
   for (int k = 0; k < 3; ++k) grad_direction[k] = (grad_unit[k] - along * unit[k]) * inv;
