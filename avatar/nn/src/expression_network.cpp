@@ -38,6 +38,12 @@ ExpressionNetworkImpl::ExpressionNetworkImpl(const NetworkOptions& options) : op
   }
 
   FieldMLPOptions mlp;
+  if (options.mlp_precision == "float32")
+    mlp.precision = MlpPrecision::kFloat32;
+  else if (options.mlp_precision == "bfloat16")
+    mlp.precision = MlpPrecision::kBFloat16;
+  else
+    throw Error(source + ": mlp_precision must be float32 or bfloat16, not '" + options.mlp_precision + "'");
   mlp.condition_channels = condition_channels;
   mlp.hidden = options.mlp_hidden;
   mlp.encoding.frequencies = options.pe_frequencies;

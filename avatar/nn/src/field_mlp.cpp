@@ -61,12 +61,19 @@ FieldMLPImpl::FieldMLPImpl(const FieldMLPOptions& options) : options_(options) {
   output_->bias.zero_();
 }
 
-at::Tensor FieldMLPImpl::first_layer(const at::Tensor& uvd, const at::Tensor& condition) const {
+at::ScalarType FieldMLPImpl::layer_type(const at::Tensor& uvd) const {
+  if (uvd.is_cuda() && options_.precision == MlpPrecision::kBFloat16) return at::kBFloat16;
+  return input_->weight.scalar_type();
+}
+
+at::Tensor FieldMLPImpl::first_layer(const at::Tensor& uvd, const at::Tensor& condition,
+                                     const at::Tensor& weight) const {
   // The first layer's weight splits into its encoding and condition columns,
   // so [PE(uvd), f] is never concatenated in memory.
   const int64_t pe_channels = options_.encoding.channels();
-  const at::Tensor& w = input_->weight;
-  const at::Tensor encoded = at::addmm(input_->bias, options_.encoding.encode(uvd), w.narrow(1, 0, pe_channels).t());
+  const at::ScalarType type = weight.scalar_type();
+  const at::Tensor encoded = at::addmm(input_->bias.to(type), options_.encoding.encode(uvd).to(type),
+                                       weight.narrow(1, 0, pe_channels).t());
   if (options_.condition_channels == 0) {
     TORCH_CHECK(!condition.defined(), "this FieldMLP takes no condition");
     return encoded;
@@ -74,13 +81,14 @@ at::Tensor FieldMLPImpl::first_layer(const at::Tensor& uvd, const at::Tensor& co
   TORCH_CHECK(condition.defined() && condition.dim() == 2 && condition.size(0) == uvd.size(0) &&
                   condition.size(1) == options_.condition_channels,
               "condition must be [N,", options_.condition_channels, "] for ", uvd.size(0), " points");
-  return at::addmm(encoded, condition, w.narrow(1, pe_channels, options_.condition_channels).t());
+  return at::addmm(encoded, condition.to(type), weight.narrow(1, pe_channels, options_.condition_channels).t());
 }
 
 at::Tensor FieldMLPImpl::forward(const at::Tensor& uvd, const at::Tensor& condition) {
-  at::Tensor h = at::silu(first_layer(uvd, condition));
-  h = at::silu(hidden_->forward(h));
-  return output_->forward(h);
+  const at::ScalarType type = layer_type(uvd);
+  at::Tensor h = at::silu(first_layer(uvd, condition, input_->weight.to(type)));
+  h = at::silu(at::linear(h, hidden_->weight.to(type), hidden_->bias.to(type)));
+  return at::linear(h, output_->weight.to(type), output_->bias.to(type)).to(output_->weight.scalar_type());
 }
 
 FieldWithJacobian FieldMLPImpl::forward_with_jacobian(const at::Tensor& uvd, const at::Tensor& condition) {
@@ -90,17 +98,23 @@ FieldWithJacobian FieldMLPImpl::forward_with_jacobian(const at::Tensor& uvd, con
   // (3f + a): one [N,features] x [features,hidden] product per axis. Three
   // plain products, not one batched one: cuBLAS computes the weight gradient
   // of a batched product with K = N as a slow batched GEMV (130 ms at 4M).
+  const at::ScalarType type = layer_type(uvd);
   const int64_t n = uvd.size(0), hidden = options_.hidden, features = options_.encoding.features();
-  const at::Tensor pe_weight = input_->weight.narrow(1, 0, options_.encoding.channels()).view({hidden, features, 3});
-  const at::Tensor derivatives = options_.encoding.axis_derivatives(uvd);  // [3,N,features]
+  const at::Tensor input_weight = input_->weight.to(type), hidden_weight = hidden_->weight.to(type),
+                   output_weight = output_->weight.to(type);
+  const at::Tensor pe_weight = input_weight.narrow(1, 0, options_.encoding.channels()).view({hidden, features, 3});
+  const at::Tensor derivatives = options_.encoding.axis_derivatives(uvd).to(type);  // [3,N,features]
   std::vector<at::Tensor> axes;
   for (int64_t a = 0; a < 3; ++a) axes.push_back(at::mm(derivatives[a], pe_weight.select(2, a).t()));
-  SiluWithTangents layer = silu_with_tangents(first_layer(uvd, condition), at::stack(axes, 1));
+  SiluWithTangents layer = silu_with_tangents(first_layer(uvd, condition, input_weight), at::stack(axes, 1));
   const auto next_tangents = [&](const at::Tensor& weight) {
     return layer.tangents.reshape({n * 3, hidden}).matmul(weight.t()).view({n, 3, -1});
   };
-  layer = silu_with_tangents(hidden_->forward(layer.value), next_tangents(hidden_->weight));
-  return {output_->forward(layer.value), next_tangents(output_->weight).transpose(1, 2)};
+  layer = silu_with_tangents(at::linear(layer.value, hidden_weight, hidden_->bias.to(type)),
+                             next_tangents(hidden_weight));
+  const at::ScalarType out = output_->weight.scalar_type();
+  return {at::linear(layer.value, output_weight, output_->bias.to(type)).to(out),
+          next_tangents(output_weight).transpose(1, 2).to(out)};
 }
 
 }  // namespace tega::nn

@@ -117,7 +117,10 @@ SiluWithTangents silu_with_tangents(const at::Tensor& pre, const at::Tensor& tan
               "silu_with_tangents: tangents must be [N,3,H] for pre ", pre.sizes(), ", got ", tangents.sizes());
   TORCH_CHECK(pre.scalar_type() == tangents.scalar_type() && pre.device() == tangents.device(),
               "silu_with_tangents: pre and tangents must share dtype and device");
-  TORCH_CHECK(!pre.is_cuda() || pre.scalar_type() == at::kFloat, "silu_with_tangents: CUDA takes float32");
+  const at::ScalarType type = pre.scalar_type();
+  TORCH_CHECK(type == at::kFloat || (pre.is_cuda() ? type == at::kBFloat16 : type == at::kDouble),
+              "silu_with_tangents: CUDA takes float32 or bfloat16, the CPU float32 or float64; got ", type, " on ",
+              pre.device());
   const variable_list out = SiluWithTangentsFunction::apply(pre.contiguous(), tangents.contiguous());
   return {out[0], out[1]};
 }

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "tega/core/error.h"
+#include "tega/core/options.h"
 #include "tega/nn/module_io.h"
 #include "tega/nn/safetensors.h"
 #include "test_support.h"
@@ -122,6 +123,24 @@ TEST(ExpressionNetwork, RejectsBadOptions) {
   NetworkOptions odd = small_options("unet");
   odd.texture_size = 18;
   EXPECT_THROW(ExpressionNetwork{odd}, Error);
+}
+
+TEST(ExpressionNetwork, MlpPrecisionLoadsFromYamlAndRejectsUnknownValues) {
+  NetworkOptions options = small_options("unet");
+  EXPECT_EQ(options.mlp_precision, "bfloat16");
+  load_options_from_string(options, "network: {mlp_precision: float32}\n", "network", "train.yaml");
+  EXPECT_EQ(options.mlp_precision, "float32");
+  EXPECT_NO_THROW(ExpressionNetwork{options});
+
+  load_options_from_string(options, "network: {mlp_precision: float16}\n", "network", "train.yaml");
+  try {
+    ExpressionNetwork{options};
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    for (const char* word : {"mlp_precision", "float32", "bfloat16", "float16"})
+      EXPECT_NE(message.find(word), std::string::npos) << message;
+  }
 }
 
 TEST(ExpressionNetwork, CheckpointsThroughSafetensors) {

@@ -82,6 +82,28 @@ TEST(FieldMLP, StartsAsANullFieldWithZeroJacobian) {
   EXPECT_GT(mlp->named_parameters()["hidden.weight"].abs().sum().item<float>(), 0.0f);
 }
 
+TEST(FieldMLP, Bfloat16PrecisionLeavesTheCpuInFloat32) {
+  FieldMLPOptions options;
+  options.condition_channels = 8;
+  options.precision = MlpPrecision::kFloat32;
+  FieldMLP plain(options);
+  options.precision = MlpPrecision::kBFloat16;
+  FieldMLP mixed(options);
+  {
+    at::NoGradGuard no_grad;
+    const auto source = plain->parameters(), target = mixed->parameters();
+    for (auto& p : source) p.normal_(0.0, 0.4);
+    for (size_t i = 0; i < source.size(); ++i) target[i].copy_(source[i]);
+  }
+  const at::Tensor uvd = random_uvd(20, at::kFloat), condition = at::randn({20, 8});
+  const FieldWithJacobian a = plain->forward_with_jacobian(uvd, condition);
+  const FieldWithJacobian b = mixed->forward_with_jacobian(uvd, condition);
+  EXPECT_EQ(b.value.scalar_type(), at::kFloat);
+  EXPECT_TRUE(at::equal(a.value, b.value));
+  EXPECT_TRUE(at::equal(a.jacobian, b.jacobian));
+  EXPECT_TRUE(at::equal(plain->forward(uvd, condition), mixed->forward(uvd, condition)));
+}
+
 TEST(FieldMLP, TangentJacobianMatchesAutogradAndFiniteDifferences) {
   FieldMLPOptions options;
   options.condition_channels = 5;

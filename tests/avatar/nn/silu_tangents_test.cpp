@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 #include <torch/csrc/autograd/autograd.h>
 
+#include <string>
+
 namespace {
 
 using tega::nn::silu_with_tangents;
@@ -75,6 +77,16 @@ TEST_F(SiluTangents, RejectsMismatchedShapes) {
   EXPECT_THROW(silu_with_tangents(pre, at::randn({37, 2, 9}, at::kDouble)), c10::Error);
   EXPECT_THROW(silu_with_tangents(pre, at::randn({37, 3, 8}, at::kDouble)), c10::Error);
   EXPECT_THROW(silu_with_tangents(pre, tangents.to(at::kFloat)), c10::Error);
+}
+
+// bfloat16 is for the CUDA kernels only (FieldMLP never sends it to the CPU).
+TEST_F(SiluTangents, TheCpuRejectsBfloat16) {
+  try {
+    silu_with_tangents(pre.detach().to(at::kBFloat16), tangents.detach().to(at::kBFloat16));
+    ADD_FAILURE() << "no error";
+  } catch (const c10::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("float32 or float64"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -37,6 +37,7 @@ struct NetworkOptions {
   int mlp_hidden = 64;
   int pe_frequencies = 6;
   double pe_depth_scale = 3.0;
+  std::string mlp_precision = "bfloat16";
 
   template <class V>
   void visit(V& v) {
@@ -49,6 +50,10 @@ struct NetworkOptions {
     v("mlp_hidden", mlp_hidden, "Width of the two hidden layers of the deformation and shading MLPs.");
     v("pe_frequencies", pe_frequencies, "Octaves of the sinusoidal positional encoding of uvd (pi * 2^k, k < this).");
     v("pe_depth_scale", pe_depth_scale, "Multiplies d (metres) before the positional encoding.");
+    v("mlp_precision", mlp_precision,
+      "What the deformation and shading MLPs' layers compute in on CUDA: float32, or bfloat16 (GEMM inputs, "
+      "activations and Jacobian tangents; weights, encoding and outputs stay float32). On the CPU they always run "
+      "in float32.");
   }
 };
 
@@ -59,7 +64,7 @@ struct Latents {
 
 class ExpressionNetworkImpl : public torch::nn::Module {
  public:
-  // Throws tega::Error for an unknown `latent` or inconsistent sizes.
+  // Throws tega::Error for an unknown `latent` or `mlp_precision`, or inconsistent sizes.
   explicit ExpressionNetworkImpl(const NetworkOptions& options);
 
   // One frame's displacement texture [3,N,N] (metres) → its latents.

@@ -50,11 +50,23 @@ struct PositionalEncoding {
   at::Tensor axis_derivatives(const at::Tensor& uvd) const;
 };
 
+// What the layers compute in on CUDA. kFloat32 keeps everything in the
+// parameters' type (float32 in training). kBFloat16 stores the GEMM inputs,
+// activations and tangents in bfloat16 (cuBLAS accumulates in float32),
+// halving the memory traffic of the [N,3,hidden] tangents and [N,hidden]
+// activations that bound the field's time at millions of Gaussians; the
+// parameters, the positional encoding math and the outputs (value, Jacobian)
+// stay in the parameters' type, and autograd trains the parameters through
+// per-call casts of the weights. On the CPU the layers always run in the
+// parameters' type.
+enum class MlpPrecision { kFloat32, kBFloat16 };
+
 struct FieldMLPOptions {
   int64_t condition_channels = 64;  // 0: no latent condition
   int64_t hidden = 64;
   int64_t outputs = 3;
   PositionalEncoding encoding;
+  MlpPrecision precision = MlpPrecision::kBFloat16;
 };
 
 struct FieldWithJacobian {
@@ -73,7 +85,9 @@ class FieldMLPImpl : public torch::nn::Module {
   const FieldMLPOptions& options() const { return options_; }
 
  private:
-  at::Tensor first_layer(const at::Tensor& uvd, const at::Tensor& condition) const;  // pre-activation
+  at::ScalarType layer_type(const at::Tensor& uvd) const;
+  // Pre-activation, with the first layer's weight already in the layers' type.
+  at::Tensor first_layer(const at::Tensor& uvd, const at::Tensor& condition, const at::Tensor& weight) const;
 
   FieldMLPOptions options_;
   torch::nn::Linear input_{nullptr}, hidden_{nullptr}, output_{nullptr};

@@ -8,8 +8,9 @@
 // Composed from tensor ops this is ~6 kernels forward and ~12 backward over
 // [N,64]-[N,3,64] tensors, the largest cost of training at millions of
 // Gaussians; fused it reads and writes each tensor once per direction. CPU
-// (float, double) and CUDA (float) share the element math
-// (src/silu_tangents_math.h). First-order differentiable (no double backward).
+// (float, double) and CUDA (float, bfloat16) share the element math
+// (src/silu_tangents_math.h), which runs in float for bfloat16 tensors.
+// First-order differentiable (no double backward).
 
 #include <ATen/core/Tensor.h>
 
