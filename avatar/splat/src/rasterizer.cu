@@ -61,25 +61,59 @@ __global__ void tile_counts_kernel(int64_t count, const int32_t* ids, const Tile
 
 // Writes each Gaussian's slots: the key of each tile of its rectangle that
 // its ellipse may touch, or `culled` (past every tile: sorted to the end and
-// never read) for the others.
-__global__ void emit_intersections_kernel(RasterInputs<float> in, const Splat2D<float>* splats, const TileRect* rects,
-                                          DepthOrder order, uint32_t* tile_keys, int32_t* gaussian_ids) {
+// never read) for the others. A warp takes 32 consecutive Gaussians of the
+// depth order, whose slots are consecutive too, and writes them a slot per
+// lane: the stores are coalesced and a Gaussian with many tiles does not
+// hold up its warp (one thread per Gaussian took four times as long).
+__global__ void __launch_bounds__(kThreads) emit_intersections_kernel(RasterInputs<float> in,
+                                                                      const Splat2D<float>* splats,
+                                                                      const TileRect* rects, DepthOrder order,
+                                                                      uint32_t* tile_keys, int32_t* gaussian_ids) {
+  struct Owner {
+    Splat2D<float> splat;
+    TileRect rect;
+    int64_t first_slot;
+    int32_t id;
+  };
+  __shared__ Owner owners[kThreads];
   const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
-  if (i >= in.num_projected()) return;
-  const int32_t id = order.ids[i];
-  const TileRect r = rects[id];
-  if (r.count() == 0) return;
-  int64_t slot = order.tile_offsets[i] - r.count();
+  const unsigned lane = threadIdx.x % 32;
+  Owner* warp_owners = owners + (threadIdx.x - lane);
+  const int64_t count = in.num_projected();
+  if (i - lane >= count) return;  // the whole warp is past the end
+  int64_t end_slot = 0;
+  Owner& mine = warp_owners[lane];
+  if (i < count) {
+    mine.id = order.ids[i];
+    mine.rect = rects[mine.id];
+    end_slot = order.tile_offsets[i];
+    mine.first_slot = end_slot - mine.rect.count();
+    if (mine.rect.count() > 0) mine.splat = splats[mine.id];
+  } else {
+    mine.first_slot = LLONG_MAX;  // never an owner
+  }
+  int64_t warp_end = end_slot;  // the offsets grow along the order: the last valid lane holds the end
+  for (int offset = 16; offset > 0; offset /= 2)
+    warp_end = max(warp_end, __shfl_xor_sync(0xffffffffu, warp_end, offset));
+  const int64_t warp_begin = __shfl_sync(0xffffffffu, mine.first_slot, 0);
+  __syncwarp();
+
   const ImageGeometry g = in.geometry;
-  const uint32_t base = uint32_t(id / in.num_gaussians) * uint32_t(g.tiles_x * g.tiles_y);
-  const uint32_t culled = uint32_t(in.num_tiles());
-  const Splat2D<float> sp = splats[id];
-  const float level = splat_level(sp);
-  for (int32_t ty = r.y0; ty < r.y1; ++ty)
-    for (int32_t tx = r.x0; tx < r.x1; ++tx, ++slot) {
-      tile_keys[slot] = splat_may_touch_tile(sp, level, g, tx, ty) ? base + uint32_t(ty * g.tiles_x + tx) : culled;
-      gaussian_ids[slot] = id;
-    }
+  const uint32_t tiles_per_camera = uint32_t(g.tiles_x * g.tiles_y), culled = uint32_t(in.num_tiles());
+  for (int64_t slot = warp_begin + lane; slot < warp_end; slot += 32) {
+    // The owner is the last lane whose first slot is at or before this one
+    // (lanes with no tiles share their successor's first slot).
+    int owner = 0;
+    for (int step = 16; step > 0; step /= 2)
+      if (warp_owners[owner + step].first_slot <= slot) owner += step;
+    const Owner& o = warp_owners[owner];
+    const int32_t local = int32_t(slot - o.first_slot), width = o.rect.x1 - o.rect.x0;
+    const int32_t ty = o.rect.y0 + local / width, tx = o.rect.x0 + local % width;
+    const bool touches = splat_may_touch_tile(o.splat, splat_level(o.splat), g, tx, ty);
+    const uint32_t camera = uint32_t(o.id / in.num_gaussians);
+    tile_keys[slot] = touches ? camera * tiles_per_camera + uint32_t(ty * g.tiles_x + tx) : culled;
+    gaussian_ids[slot] = o.id;
+  }
 }
 
 __global__ void tile_ranges_kernel(int64_t count, uint32_t culled, const uint32_t* sorted_keys, int32_t* ranges) {
