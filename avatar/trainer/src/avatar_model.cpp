@@ -7,7 +7,7 @@
 
 #include "tega/core/error.h"
 #include "tega/trainer/spherical_harmonics.h"
-#include "tega/uvd/covariance.h"
+#include "tega/uvd/fused_covariance.h"
 
 namespace tega::trainer {
 
@@ -107,21 +107,27 @@ PosedGaussians AvatarModel::pose(const FrameInput& frame, const Eigen::Vector3d&
 
   {
     TEGA_TRACE_SCOPE("covariance");
-    const at::Tensor rotation = uvd::rotation_from_quaternion(g.rotation);
-    const at::Tensor jacobian_rotation = uvd::batched_matmul(jacobian, rotation);  // [N,3,3]
-    const at::Tensor shape = jacobian_rotation * g.log_scale.exp().unsqueeze(1);    // columns scaled by std
-    out.covariances = uvd::pack_symmetric(uvd::batched_matmul(shape, shape.transpose(1, 2)));
-    out.world_std_per_scale = jacobian_rotation.detach().norm(2, 1);
+    uvd::PackedCovariance covariance = uvd::world_covariance_packed(jacobian, g.rotation, g.log_scale);
+    out.covariances = std::move(covariance.covariance);
+    out.world_std_per_scale = std::move(covariance.std_per_scale);
   }
   out.means = means;
 
   {
     TEGA_TRACE_SCOPE("colors");
-    const at::Tensor centre = at::tensor({camera_centre.x(), camera_centre.y(), camera_centre.z()},
-                                         means.options().requires_grad(false));
-    at::Tensor colors = sh_to_rgb(g.sh_dc, g.sh_rest, means - centre, phase.sh_degree);
-    if (shading.defined()) colors = colors * shading.unsqueeze(1);
-    out.colors = colors;
+    // The shading multiplier S > 0 folds into the SH coefficients, since
+    // S·max(c, 0) = max(S·c, 0): S·(C0·dc + rest·Y + ½) = C0·dc' + rest'·Y + ½
+    // with rest' = S·rest and dc' = S·dc + ½(S - 1)/C0. The rasterizer then
+    // evaluates the colour per view, with no [N,3] colour pass here.
+    const int64_t used = sh_coefficients(phase.sh_degree);
+    at::Tensor dc = g.sh_dc, rest = g.sh_rest.narrow(1, 0, used - 1);
+    if (shading.defined()) {
+      const at::Tensor s = shading.view({-1, 1, 1});
+      dc = dc * s + (0.5 / kShConstant) * (s - 1.0);
+      rest = rest * s;
+    }
+    out.sh = used > 1 ? at::cat({dc, rest}, 1) : dc;
+    out.sh_degree = phase.sh_degree;
     out.opacities = at::sigmoid(g.opacity_logit);
   }
   return out;

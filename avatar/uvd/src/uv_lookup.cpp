@@ -22,6 +22,10 @@ const at::Tensor& UvTriangleLookup::barycentric_gradient(at::ScalarType dtype) c
   return tables(dtype).gradient;
 }
 
+const at::Tensor& UvTriangleLookup::uv_corners(at::ScalarType dtype) const { return tables(dtype).corners; }
+
+const at::Tensor& UvTriangleLookup::barycentric_inverse(at::ScalarType dtype) const { return tables(dtype).inverse; }
+
 at::Tensor UvTriangleLookup::barycentrics_in(const at::Tensor& uv, const at::Tensor& triangle) const {
   const Tables& t = tables(uv.scalar_type());
   const auto corner0 = t.corners.index_select(0, triangle).select(1, 0);

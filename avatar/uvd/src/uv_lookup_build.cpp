@@ -279,6 +279,7 @@ void LookupBuilder::build(UvTriangleLookup& lookup, const Mesh& mesh, const UvLo
   for (int f = 0; f < F; ++f)
     for (int k = 0; k < 3; ++k) f_acc[f][k] = mesh.faces(f, k);
   lookup.faces_ = faces;
+  lookup.num_vertices_ = mesh.num_vertices();
   lookup.uv_area_ = area;
   lookup.double_ = {corners, inverse, gradient};
   lookup.float_ = {corners.to(at::kFloat), inverse.to(at::kFloat), gradient.to(at::kFloat)};

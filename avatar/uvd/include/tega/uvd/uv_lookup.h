@@ -78,12 +78,18 @@ class UvTriangleLookup {
 
   int64_t num_texels() const { return int64_t(cells_[0]) * cells_[1]; }
   int64_t num_triangles() const { return faces_.size(0); }
+  int64_t num_vertices() const { return num_vertices_; }  // of the mesh it was built from
   int64_t num_candidates() const { return cell_triangles_.size(0); }  // summed over texels
   const at::Tensor& faces() const { return faces_; }      // [F,3] int64 position indices
   const at::Tensor& uv_area() const { return uv_area_; }  // [F] float64, 0 unless active and nondegenerate
   // ∂(b0,b1,b2)/∂(u,v) of every triangle: [F,3,2] of the given floating dtype
   // (zero for degenerate triangles).
   const at::Tensor& barycentric_gradient(at::ScalarType dtype) const;
+  // The tables behind barycentrics_in, for fused ops that evaluate it per
+  // point: uv of the corners [F,3,2], and [F,2,2] mapping (u,v) - corner 0 to
+  // (b1,b2), of the given floating dtype.
+  const at::Tensor& uv_corners(at::ScalarType dtype) const;
+  const at::Tensor& barycentric_inverse(at::ScalarType dtype) const;
 
  private:
   struct Tables {
@@ -109,6 +115,7 @@ class UvTriangleLookup {
   at::Tensor cell_triangles_;  // int32 candidate triangles, grouped by cell
   at::Tensor faces_;           // [F,3] int64
   at::Tensor uv_area_;         // [F] float64
+  int64_t num_vertices_ = 0;
   Tables float_, double_;
 
   friend struct LookupBuilder;

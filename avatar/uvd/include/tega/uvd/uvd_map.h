@@ -7,11 +7,15 @@
 //   J_F = [∂P/∂u + d ∂n/∂u,  ∂P/∂v + d ∂n/∂v,  n],  ∂n = (I − n nᵀ) ∂m / |m|
 //
 // vᵢ are the posed positions of the triangle's corners and nᵢ the posed
-// mesh's area-weighted vertex normals. Everything is plain tensor ops on the
-// inputs' device: autograd gives ∂xyz/∂uvd = J_F and differentiates J_F itself
-// exactly (through the normal's normalisation and d), which the covariance
-// J Σ Jᵀ needs. A uv outside every triangle is moved to its closest valid
-// point; its gradient passes straight through that projection (docs).
+// mesh's area-weighted vertex normals. Everything runs on the inputs' device,
+// and the gradient w.r.t. uvd is exact: ∂xyz/∂uvd = J_F, and J_F itself is
+// differentiated through the normal's normalisation and d, which the
+// covariance J Σ Jᵀ needs. Once the triangles are known, F and J_F are one
+// fused op (CPU loops or CUDA kernels) whose gradient reaches uvd only; a
+// posed mesh whose vertices or normals require grad is mapped with
+// differentiable tensor ops instead, so that gradients reach it too. A uv
+// outside every triangle is moved to its closest valid point; its gradient
+// passes straight through that projection (docs).
 
 #include <ATen/ATen.h>
 

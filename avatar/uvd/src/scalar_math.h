@@ -1,0 +1,16 @@
+#pragma once
+// sqrt and exp for the per-element math of tega_uvd's fused ops, resolved by
+// overload to the float or double function on the host and on the device.
+
+#include <cmath>
+
+#include "tega/avatar/host_device.h"
+
+namespace tega::uvd {
+
+TEGA_HD float math_sqrt(float x) { return sqrtf(x); }
+TEGA_HD double math_sqrt(double x) { return sqrt(x); }
+TEGA_HD float math_exp(float x) { return expf(x); }
+TEGA_HD double math_exp(double x) { return exp(x); }
+
+}  // namespace tega::uvd
