@@ -11,10 +11,6 @@
 
 namespace tega::tools {
 
-namespace {
-constexpr double kC0 = 0.28209479177387814;  // Y_0^0, as in 3DGS
-}
-
 ScaleRotation decompose_covariances(const at::Tensor& covariances, double min_variance) {
   // Double precision on the CPU: Eigen's 3x3 solver is exact to rounding and
   // the result is stored as float32 anyway.
@@ -48,17 +44,12 @@ ScaleRotation decompose_covariances(const at::Tensor& covariances, double min_va
 
 GaussianCloud export_frame(trainer::AvatarModel& model, const trainer::FrameInput& frame, const trainer::Phase& phase) {
   at::NoGradGuard no_grad;
-  const trainer::PosedGaussians posed = model.pose(frame, Eigen::Vector3d::Zero(), phase);
+  const trainer::PosedGaussians posed = model.pose(frame, phase);
   const trainer::Gaussians& g = model.gaussians;
 
-  at::Tensor sh = at::cat({g.sh_dc, g.sh_rest}, 1).detach().clone();  // [N,16,3]
-  sh.slice(1, trainer::sh_coefficients(phase.sh_degree)).zero_();       // degrees the avatar does not use
-  if (phase.shading) {
-    const at::Tensor s = model.network->shade(g.uvd, posed.latents).detach().view({-1, 1});  // [N,1]
-    at::Tensor dc = sh.select(1, 0);
-    dc.copy_(((kC0 * dc + 0.5) * s - 0.5) / kC0);
-    sh.slice(1, 1).mul_(s.unsqueeze(1));
-  }
+  // posed.sh holds the degrees the avatar uses, with the shading folded in; the file has all 16 coefficients.
+  at::Tensor sh = at::zeros({g.sh_dc.size(0), trainer::sh_coefficients(3), 3}, g.sh_dc.options());
+  sh.narrow(1, 0, posed.sh.size(1)).copy_(posed.sh);
 
   const ScaleRotation shape = decompose_covariances(posed.covariances);
   GaussianCloud cloud;

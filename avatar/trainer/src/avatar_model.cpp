@@ -71,7 +71,7 @@ FrameInput AvatarModel::frame_input(const Vertices& world_vertices, const RigidT
   return frame;
 }
 
-PosedGaussians AvatarModel::pose(const FrameInput& frame, const Eigen::Vector3d& camera_centre, const Phase& phase) {
+PosedGaussians AvatarModel::pose(const FrameInput& frame, const Phase& phase) {
   PosedGaussians out;
   const Gaussians& g = gaussians;
   at::Tensor means, jacobian, triangle;

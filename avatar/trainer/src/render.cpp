@@ -31,10 +31,11 @@ at::Tensor composite_target(const at::Tensor& rgba, const at::Tensor& background
 
 at::Tensor render_view(AvatarModel& model, const FrameInput& frame, const Camera& camera, const Phase& phase,
                        const at::Tensor& background, bool antialiased) {
-  const PosedGaussians posed = model.pose(frame, camera.center(), phase);
-  const splat::RasterOutput out = splat::rasterize(posed.means, posed.covariances, posed.colors, posed.opacities,
-                                                   background, {raster_camera(camera)},
-                                                   raster_settings(camera, antialiased));
+  const PosedGaussians posed = model.pose(frame, phase);
+  splat::RasterSettings settings = raster_settings(camera, antialiased);
+  settings.sh_degree = posed.sh_degree;
+  const splat::RasterOutput out = splat::rasterize(posed.means, posed.covariances, posed.sh, posed.opacities,
+                                                   background, {raster_camera(camera)}, settings);
   return out.rgb[0].permute({2, 0, 1});
 }
 

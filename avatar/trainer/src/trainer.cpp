@@ -127,7 +127,7 @@ class Run {
   TrainSummary train(int64_t stop_at) {
     const int64_t last = stop_at > 0 ? std::min(stop_at, options_.iterations) : options_.iterations;
     ViewLoader loader(dataset_, train_views_, static_cast<uint64_t>(options_.seed), options_.loader_threads,
-                      options_.prefetch);
+                      options_.prefetch, /*pin_memory=*/device_.is_cuda());
     loader.seek(iteration_);
     const auto start = std::chrono::steady_clock::now();
     const int64_t first = iteration_;
@@ -202,19 +202,21 @@ class Run {
 
     profiler_.section("networks+jacobians");
     const FrameInput& frame = frame_input(loaded.view.frame);
-    PosedGaussians posed = model_.pose(frame, camera.center(), p);
+    PosedGaussians posed = model_.pose(frame, p);
 
     profiler_.section("rasterization");
     splat::RasterOutput raster;
     {
       RECORD_FUNCTION("tega::rasterization", std::vector<c10::IValue>());
-      raster = splat::rasterize(posed.means, posed.covariances, posed.colors, posed.opacities, background_,
-                                {raster_camera(camera)}, raster_settings(camera, options_.antialiased), &stats_);
+      splat::RasterSettings settings = raster_settings(camera, options_.antialiased);
+      settings.sh_degree = posed.sh_degree;
+      raster = splat::rasterize(posed.means, posed.covariances, posed.sh, posed.opacities, background_,
+                                {raster_camera(camera)}, settings, &stats_);
     }
 
     profiler_.section("losses");
     const at::Tensor rendered = raster.rgb[0].permute({2, 0, 1});
-    const at::Tensor target = composite_target(loaded.rgba.to(device_), background_);
+    const at::Tensor target = composite_target(loaded.rgba.to(device_, at::kByte, /*non_blocking=*/true), background_);
     at::Tensor loss;
     {
       RECORD_FUNCTION("tega::image_losses", std::vector<c10::IValue>());

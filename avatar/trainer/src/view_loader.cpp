@@ -10,8 +10,10 @@
 
 namespace tega::trainer {
 
-ViewLoader::ViewLoader(const Dataset& dataset, std::vector<View> views, uint64_t seed, int threads, int prefetch)
-    : dataset_(dataset), views_(std::move(views)), seed_(seed), prefetch_(std::max(1, prefetch)) {
+ViewLoader::ViewLoader(const Dataset& dataset, std::vector<View> views, uint64_t seed, int threads, int prefetch,
+                       bool pin_memory)
+    : dataset_(dataset), views_(std::move(views)), seed_(seed), prefetch_(std::max(1, prefetch)),
+      pin_memory_(pin_memory) {
   if (views_.empty()) throw Error(dataset.root, "has no training views (empty train split)");
   threads = std::max(1, threads);
   for (int i = 0; i < threads; ++i) workers_.emplace_back([this] { work(); });
@@ -71,11 +73,14 @@ void ViewLoader::work() {
     try {
       const auto& camera = dataset_.rig.cameras[view.camera];
       const auto path = dataset_.image_path(camera.name, dataset_.frames[view.frame].id);
-      result.image = read_image_u8(path);
-      if (result.image.channels != 4 || result.image.width != camera.width || result.image.height != camera.height) {
+      auto image = std::make_shared<Image8>(read_image_u8(path));
+      if (image->channels != 4 || image->width != camera.width || image->height != camera.height) {
         throw Error(path, "is not a " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
                               " RGBA image");
       }
+      result.rgba = at::from_blob(
+          image->pixels.data(), {image->height, image->width, 4}, [image](void*) {}, at::TensorOptions(at::kByte));
+      if (pin_memory_) result.rgba = result.rgba.pin_memory();
     } catch (const std::exception& e) {
       result.error = e.what();
     }
@@ -103,10 +108,7 @@ LoadedView ViewLoader::next() {
   wake_workers_.notify_all();
   if (!slot.error.empty()) throw Error(slot.error);
 
-  auto image = std::make_shared<Image8>(std::move(slot.image));
-  at::Tensor rgba = at::from_blob(
-      image->pixels.data(), {image->height, image->width, 4}, [image](void*) {}, at::TensorOptions(at::kByte));
-  return {view_at(position), rgba};
+  return {view_at(position), slot.rgba};
 }
 
 }  // namespace tega::trainer

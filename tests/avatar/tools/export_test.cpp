@@ -50,6 +50,40 @@ double relative_error(const at::Tensor& a, const at::Tensor& reference) {
          reference.to(at::kDouble).norm().item<double>();
 }
 
+// pose() folds the shading multiplier into the SH coefficients that the
+// rasterizer evaluates; this holds it against colours computed the direct
+// way (SH colour per view, times the shading) and rasterized as RGB.
+TEST(Export, FoldedShadingRendersLikeShadedColours) {
+  Fixture f;
+  const Camera camera = test_camera();
+  const at::Tensor background = at::full({3}, 0.2);
+  at::NoGradGuard no_grad;
+  for (const trainer::Phase phase :
+       {trainer::Phase{true, true, 3}, trainer::Phase{true, true, 2}, trainer::Phase{true, false, 1}}) {
+    SCOPED_TRACE("shading " + std::to_string(phase.shading) + ", SH degree " + std::to_string(phase.sh_degree));
+    const trainer::PosedGaussians posed = f.model->pose(f.frame, phase);
+    ASSERT_EQ(posed.sh.size(1), trainer::sh_coefficients(phase.sh_degree));
+    const trainer::Gaussians& g = f.model->gaussians;
+    const Eigen::Vector3d centre = camera.center();
+    const at::Tensor directions = posed.means - at::tensor({centre.x(), centre.y(), centre.z()}, at::kFloat);
+    at::Tensor colors = trainer::sh_to_rgb(g.sh_dc, g.sh_rest, directions, phase.sh_degree);
+    if (phase.shading) {
+      const at::Tensor shading =
+          f.model->network->shade(g.uvd, f.model->network->encode(f.frame.displacement_texture));
+      ASSERT_GT((shading - 1).abs().max().item<double>(), 0.05) << "shading must differ from 1 to test the fold";
+      colors = colors * shading.unsqueeze(1);
+    }
+    const at::Tensor expected = splat::rasterize(posed.means, posed.covariances, colors, posed.opacities, background,
+                                                 {trainer::raster_camera(camera)},
+                                                 trainer::raster_settings(camera, false))
+                                    .rgb[0]
+                                    .permute({2, 0, 1});
+    const at::Tensor actual = trainer::render_view(*f.model, f.frame, camera, phase, background, false);
+    ASSERT_GT((expected - 0.2).abs().mean().item<double>(), 0.02) << "the avatar must be in view";
+    EXPECT_LE(relative_error(actual, expected), 1e-5);
+  }
+}
+
 TEST(Export, PlyReadBackReproducesTheRenderedImage) {
   Fixture f;
   const Camera camera = test_camera();
@@ -115,7 +149,7 @@ TEST(Export, PlyHasThe3dgsLayout) {
 
   // Independent expectations for a few Gaussians.
   at::NoGradGuard no_grad;
-  const trainer::PosedGaussians posed = f.model->pose(f.frame, Eigen::Vector3d::Zero(), phase);
+  const trainer::PosedGaussians posed = f.model->pose(f.frame, phase);
   const at::Tensor shading = f.model->network->shade(f.model->gaussians.uvd, f.model->network->encode(f.frame.displacement_texture));
   ASSERT_GT((shading - 1).abs().max().item<double>(), 0.05) << "shading must differ from 1 to test the bake";
   const trainer::Gaussians& g = f.model->gaussians;

@@ -40,7 +40,8 @@ struct Phase {
 struct PosedGaussians {
   at::Tensor means;        // [N,3] world
   at::Tensor covariances;  // [N,6] packed xx, xy, xz, yy, yz, zz
-  at::Tensor colors;       // [N,3] RGB, shading applied
+  at::Tensor sh;           // [N,(sh_degree+1)²,3] SH coefficients with the shading folded in
+  int sh_degree = 0;       // the degree they hold (the rasterizer's setting)
   at::Tensor opacities;    // [N] in (0,1)
   at::Tensor world_std_per_scale;  // [N,3] world std per unit of exp(log_scale) (no grad)
   nn::Latents latents;     // this frame's latents (undefined when the field is off)
@@ -51,7 +52,7 @@ class AvatarModel {
   AvatarModel(const Dataset& dataset, const TrainOptions& options, const at::Device& device);
 
   FrameInput frame_input(const Vertices& world_vertices, const RigidTransform& head_to_world) const;
-  PosedGaussians pose(const FrameInput& frame, const Eigen::Vector3d& camera_centre, const Phase& phase);
+  PosedGaussians pose(const FrameInput& frame, const Phase& phase);
 
   Gaussians gaussians;
   nn::ExpressionNetwork network{nullptr};

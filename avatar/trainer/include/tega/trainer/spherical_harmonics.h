@@ -1,14 +1,16 @@
 #pragma once
 // View-dependent colour from real spherical harmonics (degree 0-3), in the
 // convention of 3D Gaussian Splatting: rgb = max(Σ_k Y_k(dir) h_k + 0.5, 0).
-// Evaluated with tensor ops (not inside the rasterizer) because TeGA's
-// dynamic shading multiplies this colour per Gaussian before rasterization.
+// Training lets the rasterizer evaluate the SH (the shading multiplier is
+// folded into the coefficients, AvatarModel::pose); these tensor-op versions
+// are the reference that tests hold that against.
 
 #include <ATen/ATen.h>
 
 namespace tega::trainer {
 
 constexpr int sh_coefficients(int degree) { return (degree + 1) * (degree + 1); }
+constexpr double kShConstant = 0.28209479177387814;  // Y_0^0 = C0
 
 // sh [N, K, 3] with K >= (degree+1)²; directions [N, 3] (any length, from the
 // camera centre to the Gaussian) -> rgb [N, 3]. Differentiable in sh and

@@ -35,8 +35,11 @@ struct LoadedView {
 class ViewLoader {
  public:
   // `views` must be non-empty. `threads` decode ahead of use; `prefetch`
-  // views are kept decoded or in flight beyond the current position.
-  ViewLoader(const Dataset& dataset, std::vector<View> views, uint64_t seed, int threads, int prefetch);
+  // views are kept decoded or in flight beyond the current position. With
+  // pin_memory (CUDA builds only) the images land in page-locked memory, so
+  // that their upload is a fast asynchronous copy.
+  ViewLoader(const Dataset& dataset, std::vector<View> views, uint64_t seed, int threads, int prefetch,
+             bool pin_memory = false);
   ~ViewLoader();
   ViewLoader(const ViewLoader&) = delete;
   ViewLoader& operator=(const ViewLoader&) = delete;
@@ -53,7 +56,7 @@ class ViewLoader {
  private:
   struct Slot {
     bool ready = false;
-    Image8 image;
+    at::Tensor rgba;
     std::string error;
   };
   void work();
@@ -62,6 +65,7 @@ class ViewLoader {
   std::vector<View> views_;
   uint64_t seed_;
   int prefetch_;
+  bool pin_memory_;
 
   mutable std::mutex mutex_;
   std::condition_variable wake_workers_, wake_consumer_;
