@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "adam_update.h"
 #include "tega/core/error.h"
 
 namespace tega::trainer {
@@ -36,14 +37,8 @@ void Adam::step() {
   for (auto& g : groups_) {
     const at::Tensor& grad = g.parameter.grad();
     if (!grad.defined() || g.learning_rate == 0.0) continue;
-    g.first_moment.mul_(beta1_).add_(grad, 1.0 - beta1_);
-    g.second_moment.mul_(beta2_).addcmul_(grad, grad, 1.0 - beta2_);
-    const at::Tensor denominator = (g.second_moment / correction2).sqrt_().add_(epsilon_);
-    if (g.step_scale.defined()) {
-      g.parameter.add_(g.first_moment / denominator * g.step_scale, -g.learning_rate / correction1);
-    } else {
-      g.parameter.addcdiv_(g.first_moment, denominator, -g.learning_rate / correction1);
-    }
+    adam_update::step(g.parameter, grad.contiguous(), g.first_moment, g.second_moment, g.step_scale,
+                      {beta1_, beta2_, epsilon_, g.learning_rate / correction1, 1.0 / correction2});
   }
 }
 

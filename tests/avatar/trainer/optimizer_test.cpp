@@ -1,6 +1,8 @@
 #include <ATen/ATen.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "tega/splat/gaussian_math.h"
 #include "tega/trainer/adam.h"
 #include "tega/trainer/spherical_harmonics.h"
@@ -26,6 +28,38 @@ TEST(Adam, StepScaleGivesPerColumnStepSizes) {
   p.sum().backward();
   adam.step();
   EXPECT_TRUE(at::allclose(adam.group("p").parameter.detach()[0], at::tensor({-0.5, -0.5, -2.0}, at::kDouble)));
+}
+
+// The textbook update with tensor ops, for a few steps of random gradients.
+TEST(Adam, MatchesTheTextbookUpdate) {
+  at::manual_seed(3);
+  for (const bool scaled : {false, true}) {
+    SCOPED_TRACE(scaled ? "with a step scale" : "without a step scale");
+    at::Tensor p = at::randn({50, 3}, at::kDouble).requires_grad_(true);
+    const at::Tensor scale = at::tensor({0.5, 2.0, 1.5}, at::kDouble).view({1, 3});
+    Adam adam(0.8, 0.95, 1e-8);
+    adam.add("p", p, 0.01, scaled ? scale : at::Tensor());
+    at::Tensor expected = p.detach().clone(), m = at::zeros_like(expected), v = at::zeros_like(expected);
+    for (int t = 1; t <= 4; ++t) {
+      const at::Tensor weights = at::randn({50, 3}, at::kDouble);
+      p.mutable_grad() = at::Tensor();
+      (p * weights).sum().backward();
+      adam.step();
+      m = 0.8 * m + 0.2 * weights;
+      v = 0.95 * v + 0.05 * weights * weights;
+      const at::Tensor m_hat = m / (1 - std::pow(0.8, t)), v_hat = v / (1 - std::pow(0.95, t));
+      expected = expected - 0.01 * m_hat / (v_hat.sqrt() + 1e-8) * (scaled ? scale : at::ones_like(scale));
+      EXPECT_TRUE(at::allclose(p.detach(), expected, 1e-12, 1e-12)) << "step " << t;
+    }
+  }
+}
+
+TEST(Adam, RejectsAStepScaleThatIsNotPerColumn) {
+  at::Tensor p = at::zeros({2, 3}, at::kDouble).requires_grad_(true);
+  Adam adam;
+  adam.add("p", p, 1.0, at::ones({2, 1}, at::kDouble));
+  p.sum().backward();
+  EXPECT_THROW(adam.step(), c10::Error);
 }
 
 TEST(Adam, ReplaceRowsKeepsMomentsOfKeptRowsAndZeroesNewOnes) {

@@ -1,0 +1,29 @@
+#pragma once
+// One element of an Adam step, shared by the CPU loop and the CUDA kernel
+// (plain C++17: nvcc compiles it with __host__ __device__).
+
+#include <cmath>
+
+#include "tega/avatar/host_device.h"
+
+namespace tega::trainer::adam_update {
+
+template <typename T>
+struct Constants {
+  T beta1, beta2, epsilon;
+  T step_size;          // learning rate / (1 - beta1^t)
+  T inv_correction2;    // 1 / (1 - beta2^t)
+};
+
+TEGA_HD float square_root(float x) { return sqrtf(x); }
+TEGA_HD double square_root(double x) { return sqrt(x); }
+
+// m and v move towards g and g²; p steps by step_size · scale · m̂ / (√v̂ + ε).
+template <typename T>
+TEGA_HD void step_element(T& p, T g, T& m, T& v, T scale, const Constants<T>& c) {
+  m = c.beta1 * m + (T(1) - c.beta1) * g;
+  v = c.beta2 * v + (T(1) - c.beta2) * g * g;
+  p -= c.step_size * scale * m / (square_root(v * c.inv_correction2) + c.epsilon);
+}
+
+}  // namespace tega::trainer::adam_update
