@@ -38,7 +38,8 @@ void Adam::step() {
     const at::Tensor& grad = g.parameter.grad();
     if (!grad.defined() || g.learning_rate == 0.0) continue;
     adam_update::step(g.parameter, grad.contiguous(), g.first_moment, g.second_moment, g.step_scale,
-                      {beta1_, beta2_, epsilon_, g.learning_rate / correction1, 1.0 / correction2});
+                      {beta1_, 1.0 - beta1_, beta2_, 1.0 - beta2_, epsilon_, g.learning_rate / correction1,
+                       1.0 / correction2});
   }
 }
 

@@ -29,8 +29,7 @@ void step(const at::Tensor& param, const at::Tensor& grad, const at::Tensor& fir
 #endif
   }
   AT_DISPATCH_FLOATING_TYPES(param.scalar_type(), "adam_step", [&] {
-    const Constants<scalar_t> c{scalar_t(constants.beta1), scalar_t(constants.beta2), scalar_t(constants.epsilon),
-                                scalar_t(constants.step_size), scalar_t(constants.inv_correction2)};
+    const Constants<scalar_t> c = constants_as<scalar_t>(constants);
     scalar_t* p = param.data_ptr<scalar_t>();
     const scalar_t* g = grad.data_ptr<scalar_t>();
     scalar_t* m = first_moment.data_ptr<scalar_t>();

@@ -16,8 +16,7 @@ void step_cuda(const at::Tensor& param, const at::Tensor& grad, const at::Tensor
                const at::Tensor& second_moment, const at::Tensor& column_scale, const Constants<double>& constants) {
   const c10::cuda::CUDAGuard guard(param.device());
   AT_DISPATCH_FLOATING_TYPES(param.scalar_type(), "adam_step_cuda", [&] {
-    const Constants<scalar_t> c{scalar_t(constants.beta1), scalar_t(constants.beta2), scalar_t(constants.epsilon),
-                                scalar_t(constants.step_size), scalar_t(constants.inv_correction2)};
+    const Constants<scalar_t> c = constants_as<scalar_t>(constants);
     cuda::step<scalar_t>(param.numel(), param.dim() > 0 ? param.size(-1) : 1, param.data_ptr<scalar_t>(),
                          grad.data_ptr<scalar_t>(), first_moment.data_ptr<scalar_t>(),
                          second_moment.data_ptr<scalar_t>(),
