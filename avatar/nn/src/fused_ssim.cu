@@ -17,8 +17,7 @@
 #include "fused_ssim_kernels.h"
 #include "ssim_math.h"
 
-#include <stdexcept>
-#include <string>
+#include "tega/avatar/cuda_check.h"
 
 namespace tega::nn::ssim::cuda {
 namespace {
@@ -35,10 +34,6 @@ static_assert(kThreadsX == kTileWidth, "one thread per tile column");
 static_assert(kThreadsX == 32, "a warp is one row of threads");
 static_assert(kRowsPerThread * kThreadsY == kTileHeight, "the threads cover the tile's rows");
 constexpr unsigned kFullWarp = 0xffffffffu;
-
-void check(cudaError_t status, const char* what) {
-  if (status != cudaSuccess) throw std::runtime_error(std::string("tega fused_ssim: ") + what + ": " + cudaGetErrorString(status));
-}
 
 dim3 grid_for(const Shape& shape) {
   return dim3(unsigned((shape.width + kTileWidth - 1) / kTileWidth),
@@ -207,7 +202,7 @@ void forward(const Shape& shape, const float* a, const float* b, float* block_su
              cudaStream_t stream) {
   if (pixel_count(shape) == 0) return;
   forward_kernel<<<grid_for(shape), dim3(kThreadsX, kThreadsY), 0, stream>>>(shape, a, b, block_sums, d_maps);
-  check(cudaGetLastError(), "launching forward_kernel");
+  check_launch("fused_ssim", "forward_kernel");
 }
 
 void backward(const Shape& shape, const float* a, const float* b, const float* d_maps, const float* grad_output,
@@ -215,7 +210,7 @@ void backward(const Shape& shape, const float* a, const float* b, const float* d
   if (pixel_count(shape) == 0) return;
   backward_kernel<<<grid_for(shape), dim3(kThreadsX, kThreadsY), 0, stream>>>(shape, a, b, d_maps, grad_output,
                                                                                scale, grad_a);
-  check(cudaGetLastError(), "launching backward_kernel");
+  check_launch("fused_ssim", "backward_kernel");
 }
 
 }  // namespace tega::nn::ssim::cuda

@@ -3,9 +3,8 @@
 // and the atomic adds of the latent's gradient coalesce. The uv gradient sums
 // over channels with warp shuffles, then one atomic add per point and warp.
 
-#include <stdexcept>
-#include <string>
 
+#include "tega/avatar/cuda_check.h"
 #include "latent_sampling_kernels.h"
 #include "latent_sampling_math.h"
 
@@ -14,12 +13,6 @@ namespace {
 
 constexpr int kThreads = 256;
 constexpr unsigned kFullWarp = 0xffffffffu;
-
-void check_launch(const char* kernel) {
-  const cudaError_t status = cudaGetLastError();
-  if (status != cudaSuccess)
-    throw std::runtime_error(std::string("tega sample_latent: launching ") + kernel + ": " + cudaGetErrorString(status));
-}
 
 __global__ void forward_kernel(Shape s, const float* __restrict__ latent, const float* __restrict__ uv,
                                float* __restrict__ sampled) {
@@ -81,7 +74,7 @@ void forward(const Shape& shape, const float* latent, const float* uv, float* sa
   const int64_t count = shape.points * shape.channels;
   if (count == 0) return;
   forward_kernel<<<blocks_for(count), kThreads, 0, stream>>>(shape, latent, uv, sampled);
-  check_launch("forward_kernel");
+  check_launch("sample_latent", "forward_kernel");
 }
 
 void backward(const Shape& shape, const float* latent, const float* uv, const float* grad_sampled,
@@ -90,7 +83,7 @@ void backward(const Shape& shape, const float* latent, const float* uv, const fl
   if (count == 0) return;
   backward_kernel<<<blocks_for(count), kThreads, 0, stream>>>(shape, lane_group(shape.channels), latent, uv,
                                                               grad_sampled, grad_latent, grad_uv);
-  check_launch("backward_kernel");
+  check_launch("sample_latent", "backward_kernel");
 }
 
 }  // namespace tega::nn::latent_sampling::cuda

@@ -6,9 +6,8 @@
 #include <cuda_bf16.h>
 
 #include <algorithm>
-#include <stdexcept>
-#include <string>
 
+#include "tega/avatar/cuda_check.h"
 #include "silu_tangents_kernels.h"
 #include "silu_tangents_math.h"
 
@@ -16,12 +15,6 @@ namespace tega::nn::silu_tangents::cuda {
 namespace {
 
 constexpr int kThreads = 256;
-
-void check_launch(const char* kernel) {
-  const cudaError_t status = cudaGetLastError();
-  if (status != cudaSuccess)
-    throw std::runtime_error(std::string("tega silu_with_tangents: launching ") + kernel + ": " + cudaGetErrorString(status));
-}
 
 __device__ float load(float x) { return x; }
 __device__ float load(__nv_bfloat16 x) { return __bfloat162float(x); }
@@ -77,7 +70,7 @@ void launch_forward(int64_t rows, int64_t width, const S* pre, const S* tangents
   const int64_t count = rows * width;
   if (count == 0) return;
   forward_kernel<<<blocks_for(count), kThreads, 0, stream>>>(count, width, pre, tangents, h, u);
-  check_launch("forward_kernel");
+  check_launch("silu_with_tangents", "forward_kernel");
 }
 
 template <typename S>
@@ -87,7 +80,7 @@ void launch_backward(int64_t rows, int64_t width, const S* pre, const S* tangent
   if (count == 0) return;
   backward_kernel<<<blocks_for(count), kThreads, 0, stream>>>(count, width, pre, tangents, grad_h, grad_u, grad_x,
                                                               grad_t);
-  check_launch("backward_kernel");
+  check_launch("silu_with_tangents", "backward_kernel");
 }
 
 }  // namespace

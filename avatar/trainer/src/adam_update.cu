@@ -2,8 +2,7 @@
 
 #include "adam_update_kernels.h"
 
-#include <stdexcept>
-#include <string>
+#include "tega/avatar/cuda_check.h"
 
 namespace tega::trainer::adam_update::cuda {
 namespace {
@@ -26,8 +25,7 @@ void step(int64_t count, int64_t columns, T* param, const T* grad, T* first_mome
   const int64_t blocks = (count + kThreads - 1) / kThreads;
   step_kernel<T><<<unsigned(blocks < 65536 ? blocks : 65536), kThreads, 0, stream>>>(
       count, columns, param, grad, first_moment, second_moment, column_scale, constants);
-  const cudaError_t status = cudaGetLastError();
-  if (status != cudaSuccess) throw std::runtime_error(std::string("tega adam: ") + cudaGetErrorString(status));
+  check_launch("adam", "step_kernel");
 }
 
 template void step<float>(int64_t, int64_t, float*, const float*, float*, float*, const float*,

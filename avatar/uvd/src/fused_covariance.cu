@@ -2,9 +2,8 @@
 // warp's accesses cover contiguous memory, which the caches coalesce.
 
 #include <algorithm>
-#include <stdexcept>
-#include <string>
 
+#include "tega/avatar/cuda_check.h"
 #include "fused_covariance_kernels.h"
 #include "fused_covariance_math.h"
 
@@ -12,13 +11,6 @@ namespace tega::uvd::fused_covariance::cuda {
 namespace {
 
 constexpr int kThreads = 256;
-
-void check_launch(const char* kernel) {
-  const cudaError_t status = cudaGetLastError();
-  if (status != cudaSuccess)
-    throw std::runtime_error(std::string("tega world_covariance_packed: launching ") + kernel + ": " +
-                             cudaGetErrorString(status));
-}
 
 template <typename T>
 __global__ void forward_kernel(int64_t n, const T* __restrict__ jacobian, const T* __restrict__ quaternion,
@@ -52,7 +44,7 @@ void forward(int64_t n, const T* jacobian, const T* quaternion, const T* log_sca
   if (n == 0) return;
   forward_kernel<<<blocks_for(n), kThreads, 0, stream>>>(n, jacobian, quaternion, log_scale, covariance,
                                                          std_per_scale);
-  check_launch("forward_kernel");
+  check_launch("world_covariance_packed", "forward_kernel");
 }
 
 template <typename T>
@@ -61,7 +53,7 @@ void backward(int64_t n, const T* jacobian, const T* quaternion, const T* log_sc
   if (n == 0) return;
   backward_kernel<<<blocks_for(n), kThreads, 0, stream>>>(n, jacobian, quaternion, log_scale, grad_covariance,
                                                           grad_jacobian, grad_quaternion, grad_log_scale);
-  check_launch("backward_kernel");
+  check_launch("world_covariance_packed", "backward_kernel");
 }
 
 template void forward<float>(int64_t, const float*, const float*, const float*, float*, float*, cudaStream_t);

@@ -3,21 +3,14 @@
 // mesh being small next to the points), and reads and writes its own rows.
 
 #include <algorithm>
-#include <stdexcept>
-#include <string>
 
+#include "tega/avatar/cuda_check.h"
 #include "fused_uvd_map_kernels.h"
 
 namespace tega::uvd::fused_uvd_map::cuda {
 namespace {
 
 constexpr int kThreads = 256;
-
-void check_launch(const char* kernel) {
-  const cudaError_t status = cudaGetLastError();
-  if (status != cudaSuccess)
-    throw std::runtime_error(std::string("tega uvd_to_world: launching ") + kernel + ": " + cudaGetErrorString(status));
-}
 
 template <typename T>
 __global__ void forward_kernel(int64_t n, Surface<T> surface, const int64_t* __restrict__ triangle,
@@ -48,7 +41,7 @@ void forward(int64_t n, const Surface<T>& surface, const int64_t* triangle, cons
              T* jacobian, cudaStream_t stream) {
   if (n == 0) return;
   forward_kernel<<<blocks_for(n), kThreads, 0, stream>>>(n, surface, triangle, uv, uvd, xyz, jacobian);
-  check_launch("forward_kernel");
+  check_launch("uvd_to_world", "forward_kernel");
 }
 
 template <typename T>
@@ -57,7 +50,7 @@ void backward(int64_t n, const Surface<T>& surface, const int64_t* triangle, con
   if (n == 0) return;
   backward_kernel<<<blocks_for(n), kThreads, 0, stream>>>(n, surface, triangle, uv, uvd, grad_xyz, grad_jacobian,
                                                           grad_uvd);
-  check_launch("backward_kernel");
+  check_launch("uvd_to_world", "backward_kernel");
 }
 
 template void forward<float>(int64_t, const Surface<float>&, const int64_t*, const float*, const float*, float*,
