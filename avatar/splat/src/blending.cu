@@ -10,9 +10,11 @@ namespace tega::splat::cuda {
 namespace {
 
 constexpr int kForwardThreads = kTileSize * kTileSize;  // one pixel each
-// The backward pass gives each thread two pixels, so that a splat read from
-// shared memory and each warp reduction serve 64 pixels.
-constexpr int kBackwardThreads = kTileSize * kTileSize / 2;
+// The backward pass gives each thread four pixels, so that a splat read from
+// shared memory and each warp reduction serve 128 pixels (at two pixels a
+// thread, the reductions were a third of its instructions).
+constexpr int kPixelsPerThread = 4;
+constexpr int kBackwardThreads = kTileSize * kTileSize / kPixelsPerThread;
 constexpr unsigned kFullWarp = 0xffffffffu;
 constexpr float kLog2e = 1.4426950408889634f;
 constexpr float kLn2 = 0.6931471805599453f;
@@ -74,37 +76,44 @@ __device__ __forceinline__ Exponent blend_exponent(const BlendSplat& s, float dx
   return e;
 }
 
-// Whether the splat may reach a pixel of the band of `rows` rows from y0 of
-// tile column tx, inside the image (the ellipse test that bins splats to
-// tiles, at the size of the band a warp blends).
-__device__ __forceinline__ bool band_may_touch(const Splat2D<float>& sp, const ImageGeometry& g, int32_t tx, int32_t y0,
-                                               int32_t rows) {
-  const int32_t x0 = tx * kTileSize, x1 = min(x0 + kTileSize - 1, g.width - 1);
-  const int32_t y1 = min(y0 + rows - 1, g.height - 1);
-  return y0 < g.height && splat_may_touch(sp, splat_level(sp), float(x0), float(y0), float(x1), float(y1));
+// Whether the splat may reach a pixel of a warp's block of pixels: `cols` x
+// `rows` from (x0, y0), clipped to the image (the ellipse test that bins
+// splats to tiles, at the size of the block a warp blends).
+__device__ __forceinline__ bool block_may_touch(const Splat2D<float>& sp, const ImageGeometry& g, int32_t x0,
+                                                int32_t y0, int32_t cols, int32_t rows) {
+  if (x0 >= g.width || y0 >= g.height) return false;
+  const int32_t x1 = min(x0 + cols - 1, g.width - 1), y1 = min(y0 + rows - 1, g.height - 1);
+  return splat_may_touch(sp, splat_level(sp), float(x0), float(y0), float(x1), float(y1));
 }
 
 __device__ __forceinline__ int64_t block_tile(const ImageGeometry& g) {
   return (int64_t(blockIdx.z) * g.tiles_y + blockIdx.y) * g.tiles_x + blockIdx.x;
 }
 
-// Thread t blends pixel (t % 16, t / 16) of its tile: warp w owns rows 2w
-// and 2w + 1. Each warp walks the tile's list on its own, 32 entries at a
-// time: it loads them, keeps those its band may use, and stops when its
-// pixels are done. Warps never wait for each other (with a batch shared by
-// the block, a fifth of the time went to barriers: the warps' work differs).
+// Each warp blends an 8x4 block of its tile, a pixel per lane (of the
+// shapes of 32 pixels, the squarest touches the fewest splats: a splat is
+// evaluated at all of a warp's pixels once it touches one). Each warp walks
+// the tile's list on its own, 32 entries at a time: it loads them, keeps
+// those its block may use, and stops when its pixels are done. Warps never
+// wait for each other (with a batch shared by the block, a fifth of the time
+// went to barriers: the warps' work differs).
+constexpr int kForwardCols = 8, kForwardRows = 4;
+static_assert(kForwardCols * kForwardRows == 32 && kTileSize % kForwardCols == 0 &&
+                  kForwardThreads / 32 == (kTileSize / kForwardCols) * (kTileSize / kForwardRows),
+              "the warps' blocks must tile a tile");
+
 __global__ void __launch_bounds__(kForwardThreads) render_forward_kernel(RasterInputs<float> in,
                                                                          const Splat2D<float>* splats, TileBins bins,
                                                                          ImageBuffers<float> image) {
-  constexpr int kWarps = kForwardThreads / 32, kBandRows = kTileSize / kWarps;
+  constexpr int kWarps = kForwardThreads / 32, kBlocksAcross = kTileSize / kForwardCols;
   __shared__ BlendSplat batches[kWarps][32];
   const ImageGeometry g = in.geometry;
   const int64_t tile = block_tile(g);
   const unsigned lane = threadIdx.x % 32, warp = threadIdx.x / 32;
   BlendSplat* batch = batches[warp];
-  const int32_t x = int32_t(blockIdx.x) * kTileSize + int32_t(threadIdx.x % kTileSize);
-  const int32_t y = int32_t(blockIdx.y) * kTileSize + int32_t(threadIdx.x / kTileSize);
-  const int32_t band_y0 = int32_t(blockIdx.y) * kTileSize + kBandRows * int32_t(warp);
+  const int32_t block_x0 = int32_t(blockIdx.x) * kTileSize + kForwardCols * int32_t(warp % kBlocksAcross);
+  const int32_t block_y0 = int32_t(blockIdx.y) * kTileSize + kForwardRows * int32_t(warp / kBlocksAcross);
+  const int32_t x = block_x0 + int32_t(lane % kForwardCols), y = block_y0 + int32_t(lane / kForwardCols);
   const bool inside = x < g.width && y < g.height;
   const float px = float(x), py = float(y);
   const int32_t begin = bins.ranges[2 * tile], end = bins.ranges[2 * tile + 1];
@@ -117,7 +126,7 @@ __global__ void __launch_bounds__(kForwardThreads) render_forward_kernel(RasterI
     bool used = false;
     if (k < end) {
       const Splat2D<float> sp = load_splat(splats + bins.gaussian_ids[k]);
-      used = band_may_touch(sp, g, blockIdx.x, band_y0, kBandRows);
+      used = block_may_touch(sp, g, block_x0, block_y0, kForwardCols, kForwardRows);
       if (used) batch[lane] = blend_splat(sp);
     }
     uint32_t pending = __ballot_sync(kFullWarp, used);
@@ -158,7 +167,8 @@ __global__ void __launch_bounds__(kForwardThreads) render_forward_kernel(RasterI
 }
 
 // One pixel of the backward walk, back to front (PixelBackward's fields, with
-// the final-transmittance term folded into one number).
+// the final-transmittance term folded into one number). The depth fields are
+// used only when the loss depends on the depth image.
 struct PixelState {
   float grad_rgb[3], grad_depth;
   float final_term;  // T_final (dL/dalpha_out - background · dL/drgb)
@@ -176,6 +186,7 @@ __device__ __forceinline__ int splat_field_offset(int field) { return field < kR
 
 // Adds splat s's gradient at one pixel to `grad` and steps the pixel's state
 // to the splat's front. False when the pixel skipped the splat.
+template <bool kWithDepth>
 __device__ __forceinline__ bool blend_backward_pixel(PixelState& st, const BlendSplat& s, float px, float py,
                                                      float (&grad)[kFields]) {
   const float dx = px - s.u, dy = py - s.v;
@@ -190,18 +201,21 @@ __device__ __forceinline__ bool blend_backward_pixel(PixelState& st, const Blend
   grad[kRed] = fmaf(w, st.grad_rgb[0], grad[kRed]);
   grad[kGreen] = fmaf(w, st.grad_rgb[1], grad[kGreen]);
   grad[kBlue] = fmaf(w, st.grad_rgb[2], grad[kBlue]);
-  grad[kDepth] = fmaf(w, st.grad_depth, grad[kDepth]);
   const float d_red = s.red - st.behind_rgb[0], d_green = s.green - st.behind_rgb[1];
-  const float d_blue = s.blue - st.behind_rgb[2], d_depth = s.depth - st.behind_depth;
+  const float d_blue = s.blue - st.behind_rgb[2];
   float grad_alpha = d_red * st.grad_rgb[0];
   grad_alpha = fmaf(d_green, st.grad_rgb[1], grad_alpha);
   grad_alpha = fmaf(d_blue, st.grad_rgb[2], grad_alpha);
-  grad_alpha = fmaf(d_depth, st.grad_depth, grad_alpha);
+  if constexpr (kWithDepth) {
+    const float d_depth = s.depth - st.behind_depth;
+    grad[kDepth] = fmaf(w, st.grad_depth, grad[kDepth]);
+    grad_alpha = fmaf(d_depth, st.grad_depth, grad_alpha);
+    st.behind_depth = fmaf(alpha, d_depth, st.behind_depth);
+  }
   grad_alpha = fmaf(grad_alpha, t, st.final_term * inv_one_minus);
   st.behind_rgb[0] = fmaf(alpha, d_red, st.behind_rgb[0]);
   st.behind_rgb[1] = fmaf(alpha, d_green, st.behind_rgb[1]);
   st.behind_rgb[2] = fmaf(alpha, d_blue, st.behind_rgb[2]);
-  st.behind_depth = fmaf(alpha, d_depth, st.behind_depth);
   if (raw_alpha > float(kMaxAlpha)) return true;  // clamped: no gradient to opacity or shape
   grad[kOpacity] = fmaf(gaussian, grad_alpha, grad[kOpacity]);
   // d loss / d power, power = p ln 2 the natural exponent; its derivatives
@@ -257,15 +271,18 @@ __device__ __forceinline__ float warp_reduce_scatter(const float (&v)[kFields]) 
   return total + __shfl_xor_sync(kFullWarp, total, 1);
 }
 
-// Thread t of warp w blends column t % 16 of rows 4w + t / 16 and 4w + t / 16 + 2:
-// warp w owns rows [4w, 4w + 4) of the tile. Like the forward pass, each warp
-// walks the list on its own, from the last entry its pixels blended.
+// Warp w blends rows [8w, 8w + 8) of the tile, and lane l column l % 16 of
+// its rows l / 16 + 2k, k < 4. Like the forward pass, each warp walks the
+// list on its own, from the last entry its pixels blended. kWithDepth: the
+// loss depends on the depth image.
+template <bool kWithDepth>
 __global__ void __launch_bounds__(kBackwardThreads) render_backward_kernel(RasterInputs<float> in,
                                                                            const Splat2D<float>* splats,
                                                                            TileBins bins, ImageBuffers<float> image,
                                                                            ImageGradients<float> grads,
                                                                            Splat2D<float>* splat_grads) {
-  constexpr int kWarps = kBackwardThreads / 32, kBandRows = kTileSize / kWarps;
+  constexpr int kWarps = kBackwardThreads / 32, kBlockRows = kTileSize / kWarps, kRowStep = 32 / kTileSize;
+  static_assert(kBlockRows == kRowStep * kPixelsPerThread, "a warp's lanes cover its rows");
   __shared__ BlendSplat batches[kWarps][32];
   __shared__ int32_t batch_ids[kWarps][32];
   const ImageGeometry g = in.geometry;
@@ -274,24 +291,27 @@ __global__ void __launch_bounds__(kBackwardThreads) render_backward_kernel(Raste
   const unsigned lane = threadIdx.x % 32, warp = threadIdx.x / 32;
   BlendSplat* batch = batches[warp];
   int32_t* ids = batch_ids[warp];
-  const int32_t x = int32_t(blockIdx.x) * kTileSize + int32_t(lane % kTileSize);
-  const int32_t band_y0 = int32_t(blockIdx.y) * kTileSize + kBandRows * int32_t(warp);
+  const int32_t block_x0 = int32_t(blockIdx.x) * kTileSize;
+  const int32_t block_y0 = int32_t(blockIdx.y) * kTileSize + kBlockRows * int32_t(warp);
+  const int32_t x = block_x0 + int32_t(lane % kTileSize);
   const float px = float(x);
   const float* bg = in.background;
 
-  PixelState st[2];
-  float py[2];
-  int32_t last[2] = {0, 0};
+  PixelState st[kPixelsPerThread];
+  float py[kPixelsPerThread];
+  int32_t last[kPixelsPerThread];
+  int32_t thread_last = 0;
 #pragma unroll
-  for (int p = 0; p < 2; ++p) {
-    const int32_t y = band_y0 + int32_t(lane / kTileSize) + 2 * p;
+  for (int p = 0; p < kPixelsPerThread; ++p) {
+    const int32_t y = block_y0 + int32_t(lane / kTileSize) + kRowStep * p;
     py[p] = float(y);
     float grad_alpha_out = 0.0f, final_transmittance = 0.0f;
     st[p] = {};
+    last[p] = 0;
     if (x < g.width && y < g.height) {
       const int64_t pixel = (int64_t(blockIdx.z) * g.height + y) * g.width + x;
       for (int ch = 0; ch < 3; ++ch) st[p].grad_rgb[ch] = grads.rgb[3 * pixel + ch];
-      st[p].grad_depth = grads.depth[pixel];
+      if constexpr (kWithDepth) st[p].grad_depth = grads.depth[pixel];
       grad_alpha_out = grads.alpha[pixel];
       final_transmittance = image.final_transmittance[pixel];
       last[p] = image.last[pixel];
@@ -299,12 +319,13 @@ __global__ void __launch_bounds__(kBackwardThreads) render_backward_kernel(Raste
     const float background_dot = bg[0] * st[p].grad_rgb[0] + bg[1] * st[p].grad_rgb[1] + bg[2] * st[p].grad_rgb[2];
     st[p].final_term = final_transmittance * (grad_alpha_out - background_dot);
     st[p].transmittance = final_transmittance;
+    thread_last = max(thread_last, last[p]);
   }
   const int field = reduced_field(lane);
-  const bool writes = field >= 0 && (lane & 1) == 0;
+  const bool writes = field >= 0 && (lane & 1) == 0 && (kWithDepth || field != kDepth);
   const int field_offset = writes ? splat_field_offset(field) : 0;
   const float field_scale = writes ? kFieldScale[field] : 0.0f;
-  const int32_t warp_last = int32_t(__reduce_max_sync(kFullWarp, unsigned(max(last[0], last[1]))));
+  const int32_t warp_last = int32_t(__reduce_max_sync(kFullWarp, unsigned(thread_last)));
 
   // Back to front: lane l loads entry stop - 1 - l, so batch[j] is entry
   // stop - 1 - j of the tile.
@@ -314,7 +335,7 @@ __global__ void __launch_bounds__(kBackwardThreads) render_backward_kernel(Raste
     if (k >= begin) {
       const int32_t id = bins.gaussian_ids[k];
       const Splat2D<float> sp = load_splat(splats + id);
-      used = band_may_touch(sp, g, blockIdx.x, band_y0, kBandRows);
+      used = block_may_touch(sp, g, block_x0, block_y0, kTileSize, kBlockRows);
       if (used) {
         batch[lane] = blend_splat(sp);
         ids[lane] = id;
@@ -329,8 +350,9 @@ __global__ void __launch_bounds__(kBackwardThreads) render_backward_kernel(Raste
       const BlendSplat s = batch[j];
       float grad[kFields] = {};
       bool contributed = false;
-      if (index_in_tile < last[0]) contributed |= blend_backward_pixel(st[0], s, px, py[0], grad);
-      if (index_in_tile < last[1]) contributed |= blend_backward_pixel(st[1], s, px, py[1], grad);
+#pragma unroll
+      for (int p = 0; p < kPixelsPerThread; ++p)
+        if (index_in_tile < last[p]) contributed |= blend_backward_pixel<kWithDepth>(st[p], s, px, py[p], grad);
       if (!__any_sync(kFullWarp, contributed)) continue;
       const float total = warp_reduce_scatter(grad);
       if (writes) atomicAdd(reinterpret_cast<float*>(&splat_grads[ids[j]]) + field_offset, total * field_scale);
@@ -354,7 +376,11 @@ void render_backward(const RasterInputs<float>& in, const Splat2D<float>* splats
                      Splat2D<float>* splat_grads, cudaStream_t stream) {
   if (in.num_pixels() == 0) return;
   const dim3 grid(in.geometry.tiles_x, in.geometry.tiles_y, in.num_cameras);
-  render_backward_kernel<<<grid, kBackwardThreads, 0, stream>>>(in, splats, bins, image, grads, splat_grads);
+  if (grads.depth) {
+    render_backward_kernel<true><<<grid, kBackwardThreads, 0, stream>>>(in, splats, bins, image, grads, splat_grads);
+  } else {
+    render_backward_kernel<false><<<grid, kBackwardThreads, 0, stream>>>(in, splats, bins, image, grads, splat_grads);
+  }
   TEGA_CHECK_LAUNCH(render_backward_kernel);
 }
 

@@ -121,7 +121,7 @@ void render_backward(const RasterInputs<T>& in, const Splat2D<T>* splats, const 
           PixelBackward<T> st;
           for (int ch = 0; ch < 3; ++ch) st.grad_rgb[ch] = grads.rgb[3 * pixel + ch];
           st.grad_alpha_out = grads.alpha[pixel];
-          st.grad_depth = grads.depth[pixel];
+          st.grad_depth = grads.depth ? grads.depth[pixel] : T(0);
           st.final_transmittance = image.final_transmittance[pixel];
           st.transmittance = st.final_transmittance;
           st.background_dot = bg[0] * st.grad_rgb[0] + bg[1] * st.grad_rgb[1] + bg[2] * st.grad_rgb[2];

@@ -63,7 +63,7 @@ template <typename T>
 struct ImageGradients {
   const T* rgb = nullptr;    // [C, H, W, 3]
   const T* alpha = nullptr;  // [C, H, W]
-  const T* depth = nullptr;  // [C, H, W]
+  const T* depth = nullptr;  // [C, H, W]; null when the loss does not depend on depth
 };
 
 // Outputs of the backward pass. grad_colors has the colours' shape; the

@@ -30,7 +30,8 @@ struct ForwardTensors {
 };
 
 struct ImageGradTensors {
-  at::Tensor rgb, alpha, depth;  // contiguous
+  at::Tensor rgb, alpha;  // contiguous
+  at::Tensor depth;       // contiguous; undefined when the loss does not depend on depth
 };
 
 struct InputGradTensors {

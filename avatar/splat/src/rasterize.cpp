@@ -103,6 +103,9 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
       ctx->saved_data["stats_count"] = stats.visible_count;
     }
     ctx->mark_non_differentiable({f.radii});
+    // An output the loss does not use gets an undefined gradient rather than
+    // zeros: without depth in the loss, the backward pass skips its terms.
+    ctx->set_materialize_grads(false);
     return {f.rgb, f.alpha, f.depth, f.radii};
   }
 
@@ -116,8 +119,14 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
     f.last = saved[8];
     f.ranges = saved[9];
     f.gaussian_ids = saved[10];
-    const glue::ImageGradTensors grads{grad_outputs[0].contiguous(), grad_outputs[1].contiguous(),
-                                       grad_outputs[2].contiguous()};
+    const at::Tensor& transmittance = f.final_transmittance;  // [C, H, W]
+    const auto defined_or_zeros = [&](const at::Tensor& grad, at::IntArrayRef shape) {
+      return grad.defined() ? grad.contiguous() : at::zeros(shape, transmittance.options());
+    };
+    const glue::ImageGradTensors grads{
+        defined_or_zeros(grad_outputs[0], {transmittance.size(0), transmittance.size(1), transmittance.size(2), 3}),
+        defined_or_zeros(grad_outputs[1], transmittance.sizes()),
+        grad_outputs[2].defined() ? grad_outputs[2].contiguous() : at::Tensor()};
     MeanGradientStats stats;
     const bool has_stats = ctx->saved_data.count("stats_sum") > 0;
     if (has_stats) {

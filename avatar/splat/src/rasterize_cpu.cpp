@@ -60,7 +60,8 @@ InputGradTensors backward(const RasterTensors& t, const CallConfig& config, cons
                               saved.last.data_ptr<int32_t>()};
   at::Tensor splat_grads = at::empty_like(saved.splats);
   cpu::render_backward(in, splat_ptr<T>(saved.splats), bins, image,
-                       ImageGradients<T>{grads.rgb.data_ptr<T>(), grads.alpha.data_ptr<T>(), grads.depth.data_ptr<T>()},
+                       ImageGradients<T>{grads.rgb.data_ptr<T>(), grads.alpha.data_ptr<T>(),
+                                         grads.depth.defined() ? grads.depth.data_ptr<T>() : nullptr},
                        splat_ptr<T>(splat_grads));
 
   InputGradTensors out{at::empty_like(t.means), at::empty_like(t.covariances), at::empty_like(t.colors),

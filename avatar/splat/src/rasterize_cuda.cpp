@@ -100,7 +100,7 @@ InputGradTensors backward_cuda(const RasterTensors& t, const CallConfig& config,
   at::Tensor splat_grads = at::zeros_like(saved.splats);
   cuda::render_backward(in, splat_ptr(saved.splats), bins, image,
                         ImageGradients<float>{grads.rgb.data_ptr<float>(), grads.alpha.data_ptr<float>(),
-                                              grads.depth.data_ptr<float>()},
+                                              grads.depth.defined() ? grads.depth.data_ptr<float>() : nullptr},
                         splat_ptr(splat_grads), stream);
 
   InputGradTensors out{at::empty_like(t.means), at::empty_like(t.covariances), at::empty_like(t.colors),

@@ -26,9 +26,10 @@ RenderRun render_with_grads(const Scene& scene, const at::Tensor& weight_rgb, co
   run.stats = MeanGradientStats::zeros(s.means);
   run.out = s.render(&run.stats);
   const auto device = s.means.device();
-  const at::Tensor loss = (run.out.rgb * weight_rgb.to(device, run.out.rgb.scalar_type())).sum() +
-                          (run.out.alpha * weight_alpha.to(device, run.out.alpha.scalar_type())).sum() +
-                          (run.out.depth * weight_depth.to(device, run.out.depth.scalar_type())).sum();
+  at::Tensor loss = (run.out.rgb * weight_rgb.to(device, run.out.rgb.scalar_type())).sum() +
+                    (run.out.alpha * weight_alpha.to(device, run.out.alpha.scalar_type())).sum();
+  // Without depth in the loss, the CUDA backward runs its depth-free variant.
+  if (weight_depth.defined()) loss = loss + (run.out.depth * weight_depth.to(device, run.out.depth.scalar_type())).sum();
   run.grads = torch::autograd::grad({loss}, s.inputs());
   return run;
 }
@@ -41,14 +42,12 @@ class CudaParityTest : public ::testing::TestWithParam<SceneSpec> {
   }
 };
 
-TEST_P(CudaParityTest, MatchesCpuInDouble) {
-  // Float inputs, so that both pipelines see exactly the same values.
-  const Scene scene = random_scene(GetParam()).to(at::kFloat);
+void expect_cuda_matches_cpu(const Scene& scene, bool depth_in_loss) {
   const auto opts = at::TensorOptions().dtype(at::kDouble);
   const int64_t c = int64_t(scene.cameras.size()), h = scene.settings.height, w = scene.settings.width;
   const at::Tensor weight_rgb = at::rand({c, h, w, 3}, opts) * 2 - 1;
   const at::Tensor weight_alpha = at::rand({c, h, w}, opts) * 2 - 1;
-  const at::Tensor weight_depth = (at::rand({c, h, w}, opts) * 2 - 1) * 0.1;
+  const at::Tensor weight_depth = depth_in_loss ? (at::rand({c, h, w}, opts) * 2 - 1) * 0.1 : at::Tensor();
 
   const RenderRun cpu = render_with_grads(scene.to(at::kDouble), weight_rgb, weight_alpha, weight_depth);
   const RenderRun gpu = render_with_grads(scene.to(at::kFloat, at::kCUDA), weight_rgb, weight_alpha, weight_depth);
@@ -64,6 +63,15 @@ TEST_P(CudaParityTest, MatchesCpuInDouble) {
     EXPECT_LT(relative_error(gpu.grads[i], cpu.grads[i]), 1e-3) << names[i];
   EXPECT_LT(relative_error(gpu.stats.grad_norm_sum, cpu.stats.grad_norm_sum), 1e-3);
   EXPECT_TRUE(at::equal(gpu.stats.visible_count.cpu(), cpu.stats.visible_count));
+}
+
+// Float inputs, so that both pipelines see exactly the same values.
+TEST_P(CudaParityTest, MatchesCpuInDouble) {
+  expect_cuda_matches_cpu(random_scene(GetParam()).to(at::kFloat), /*depth_in_loss=*/true);
+}
+
+TEST_P(CudaParityTest, MatchesCpuInDoubleWithoutDepthInTheLoss) {
+  expect_cuda_matches_cpu(random_scene(GetParam()).to(at::kFloat), /*depth_in_loss=*/false);
 }
 
 SceneSpec spec(ColorMode colors, bool antialiased, uint64_t seed) {

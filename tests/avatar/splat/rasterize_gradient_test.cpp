@@ -84,6 +84,35 @@ TEST_P(GradientTest, EveryInputMatchesFiniteDifferences) {
   }
 }
 
+// Outputs the loss leaves out reach the backward pass as undefined gradients
+// (the rasterizer skips their terms); the result must be that of zero weights.
+TEST(Rasterize, OutputsLeftOutOfTheLossActAsZeroWeights) {
+  SceneSpec s;
+  s.seed = 15;
+  const Scene scene = random_scene(s);
+  const int64_t c = int64_t(scene.cameras.size()), h = scene.settings.height, w = scene.settings.width;
+  const at::Tensor weight_rgb = at::rand({c, h, w, 3}, at::TensorOptions().dtype(at::kDouble)) * 2 - 1;
+  const auto gradients = [&](bool zero_weighted_outputs) {
+    std::vector<at::Tensor> inputs = scene.inputs();
+    for (at::Tensor& t : inputs) t = t.clone().requires_grad_();
+    Scene differentiable = scene;
+    differentiable.means = inputs[0];
+    differentiable.covariances = inputs[1];
+    differentiable.colors = inputs[2];
+    differentiable.opacities = inputs[3];
+    differentiable.background = inputs[4];
+    const RasterOutput out = differentiable.render();
+    at::Tensor loss = (out.rgb * weight_rgb).sum();
+    if (zero_weighted_outputs) loss = loss + (out.alpha * 0).sum() + (out.depth * 0).sum();
+    return torch::autograd::grad({loss}, inputs);
+  };
+  const std::vector<at::Tensor> rgb_only = gradients(false), zero_weighted = gradients(true);
+  for (std::size_t i = 0; i < rgb_only.size(); ++i) {
+    EXPECT_GT(rgb_only[i].abs().max().item<double>(), 1e-3) << "input " << i;
+    EXPECT_TRUE(at::allclose(rgb_only[i], zero_weighted[i], 1e-12, 1e-12)) << "input " << i;
+  }
+}
+
 SceneSpec spec(ColorMode colors, bool antialiased, int sh_degree, uint64_t seed) {
   SceneSpec s;
   s.colors = colors;
