@@ -11,9 +11,11 @@
 
 namespace tega::nn::latent_sampling {
 
-template <typename T>
+// Index: the integer type of texel indices (the CUDA backward uses int, which
+// is cheaper there, for textures below 2^31 texels).
+template <typename T, typename Index = int64_t>
 struct Taps {
-  int64_t texel[4];  // row-major texel indices: (y0,x0), (y0,x1), (y1,x0), (y1,x1)
+  Index texel[4];  // row-major texel indices: (y0,x0), (y0,x1), (y1,x0), (y1,x1)
   T weight[4];
   T dweight_du[4];   // ∂weight/∂u, ∂weight/∂v
   T dweight_dv[4];
@@ -21,22 +23,22 @@ struct Taps {
 
 // Pixel coordinate along one axis, clamped to [0, size-1]; `rate` is its
 // derivative w.r.t. the texture coordinate (0 where clamped).
-template <typename T>
-TEGA_HD void clamped_coordinate(T pixel, int64_t size, T scale, T& coordinate, T& rate) {
+template <typename T, typename Index>
+TEGA_HD void clamped_coordinate(T pixel, Index size, T scale, T& coordinate, T& rate) {
   const T high = T(size - 1);
   coordinate = pixel < T(0) ? T(0) : (pixel > high ? high : pixel);
   rate = (pixel < T(0) || pixel > high) ? T(0) : scale;
 }
 
-template <typename T>
-TEGA_HD Taps<T> taps(T u, T v, int64_t height, int64_t width) {
+template <typename T, typename Index = int64_t>
+TEGA_HD Taps<T, Index> taps(T u, T v, Index height, Index width) {
   T x, y, dx_du, dy_dv;
   clamped_coordinate(u * T(width) - T(0.5), width, T(width), x, dx_du);
   clamped_coordinate((T(1) - v) * T(height) - T(0.5), height, -T(height), y, dy_dv);
-  const int64_t x0 = int64_t(x), y0 = int64_t(y);  // x, y >= 0: truncation is floor
-  const int64_t x1 = x0 + 1 < width ? x0 + 1 : x0, y1 = y0 + 1 < height ? y0 + 1 : y0;
+  const Index x0 = Index(x), y0 = Index(y);  // x, y >= 0: truncation is floor
+  const Index x1 = x0 + 1 < width ? x0 + 1 : x0, y1 = y0 + 1 < height ? y0 + 1 : y0;
   const T fx = x - T(x0), fy = y - T(y0);
-  Taps<T> t;
+  Taps<T, Index> t;
   t.texel[0] = y0 * width + x0;
   t.texel[1] = y0 * width + x1;
   t.texel[2] = y1 * width + x0;
