@@ -75,14 +75,29 @@ at::Tensor ExpressionNetworkImpl::condition(const at::Tensor& latent, const at::
   return sample_latent(latent, uvd.narrow(1, 0, 2));
 }
 
-FieldWithJacobian ExpressionNetworkImpl::deform(const at::Tensor& uvd, const Latents& latents, bool with_jacobian) {
+EncodedPositions ExpressionNetworkImpl::encode_positions(const at::Tensor& uvd, bool with_derivatives) const {
+  // Both fields were built with the same encoding and precision options.
+  return deformation_->encode(uvd, with_derivatives);
+}
+
+FieldWithJacobian ExpressionNetworkImpl::deform(const at::Tensor& uvd, const EncodedPositions& encoded,
+                                                const Latents& latents, bool with_jacobian) {
   const at::Tensor f = condition(latents.deformation, uvd);
-  if (with_jacobian) return deformation_->forward_with_jacobian(uvd, f);
-  return {deformation_->forward(uvd, f), {}};
+  if (with_jacobian) return deformation_->forward_with_jacobian(encoded, f);
+  return {deformation_->forward(encoded, f), {}};
+}
+
+at::Tensor ExpressionNetworkImpl::shade(const at::Tensor& uvd, const EncodedPositions& encoded,
+                                        const Latents& latents) {
+  return 2 * at::sigmoid(shading_->forward(encoded, condition(latents.shading, uvd)).squeeze(1));
+}
+
+FieldWithJacobian ExpressionNetworkImpl::deform(const at::Tensor& uvd, const Latents& latents, bool with_jacobian) {
+  return deform(uvd, encode_positions(uvd, with_jacobian), latents, with_jacobian);
 }
 
 at::Tensor ExpressionNetworkImpl::shade(const at::Tensor& uvd, const Latents& latents) {
-  return 2 * at::sigmoid(shading_->forward(uvd, condition(latents.shading, uvd)).squeeze(1));
+  return shade(uvd, encode_positions(uvd, /*with_derivatives=*/false), latents);
 }
 
 }  // namespace tega::nn

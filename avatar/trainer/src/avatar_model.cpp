@@ -89,9 +89,14 @@ PosedGaussians AvatarModel::pose(const FrameInput& frame, const Phase& phase) {
       TEGA_TRACE_SCOPE("encoder");
       out.latents = network->encode(frame.displacement_texture);
     }
+    nn::EncodedPositions encoded;
+    {
+      TEGA_TRACE_SCOPE("positional_encoding");
+      encoded = network->encode_positions(g.uvd, /*with_derivatives=*/phase.deformation);
+    }
     if (phase.deformation) {
       TEGA_TRACE_SCOPE("deformation_field");
-      const nn::FieldWithJacobian field = network->deform(g.uvd, out.latents, /*with_jacobian=*/true);
+      const nn::FieldWithJacobian field = network->deform(g.uvd, encoded, out.latents, /*with_jacobian=*/true);
       const at::Tensor movable = eyeball_face_mask_.index_select(0, triangle).logical_not().to(means.dtype());
       // Head space -> world: Δ_world = R Δ, J_world = R J (row vectors: Δ Rᵀ).
       means = means + field.value.matmul(frame.head_rotation.t()) * movable.unsqueeze(1);
@@ -101,7 +106,7 @@ PosedGaussians AvatarModel::pose(const FrameInput& frame, const Phase& phase) {
     }
     if (phase.shading) {
       TEGA_TRACE_SCOPE("shading_field");
-      shading = network->shade(g.uvd, out.latents);
+      shading = network->shade(g.uvd, encoded, out.latents);
     }
   }
 

@@ -69,9 +69,16 @@ class ExpressionNetworkImpl : public torch::nn::Module {
 
   // One frame's displacement texture [3,N,N] (metres) → its latents.
   Latents encode(const at::Tensor& displacement_texture);
+  // The positional encoding of uvd [N,3] that both fields read (with its
+  // derivatives when deform() is to return a Jacobian), computed once for both.
+  EncodedPositions encode_positions(const at::Tensor& uvd, bool with_derivatives) const;
   // Δxyz [N,3] at uvd [N,3]; the Jacobian ∂Δxyz/∂uvd [N,3,3] too when asked.
-  FieldWithJacobian deform(const at::Tensor& uvd, const Latents& latents, bool with_jacobian);
+  FieldWithJacobian deform(const at::Tensor& uvd, const EncodedPositions& encoded, const Latents& latents,
+                           bool with_jacobian);
   // Shading factor [N] in (0, 2).
+  at::Tensor shade(const at::Tensor& uvd, const EncodedPositions& encoded, const Latents& latents);
+  // The same, encoding uvd for the one call.
+  FieldWithJacobian deform(const at::Tensor& uvd, const Latents& latents, bool with_jacobian);
   at::Tensor shade(const at::Tensor& uvd, const Latents& latents);
 
   const NetworkOptions& options() const { return options_; }

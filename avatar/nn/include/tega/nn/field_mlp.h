@@ -26,29 +26,12 @@
 #include <torch/nn/modules/linear.h>
 #include <torch/nn/pimpl.h>
 
+#include "tega/nn/positional_encoding.h"
+
+#include <utility>
 #include <vector>
 
 namespace tega::nn {
-
-// PE(uvd) = [x, sin(2^k π x), cos(2^k π x)] for k = 0..frequencies-1, where
-// x = (u, v, depth_scale·d) with d in metres. depth_scale maps d to units
-// comparable with uv (1 unit of u spans roughly 0.3 m of face, so the
-// default 3 makes 1 unit of scaled d ≈ 0.33 m).
-//
-// Channel 3f + a is feature f (x, then sin and cos per octave) of axis a, so
-// every channel depends on one axis only: its derivative is a single number,
-// and axis_derivatives() holds [3, N, features()] of them instead of a mostly
-// zero [N, 3, channels()] Jacobian.
-struct PositionalEncoding {
-  int64_t frequencies = 6;
-  double depth_scale = 3.0;
-
-  int64_t features() const { return 1 + 2 * frequencies; }
-  int64_t channels() const { return 3 * features(); }
-  at::Tensor encode(const at::Tensor& uvd) const;  // [N,3] → [N,channels()]
-  // ∂ channel (3f + a) / ∂ uvd_a as [3 (a), N, features() (f)].
-  at::Tensor axis_derivatives(const at::Tensor& uvd) const;
-};
 
 // What the layers compute in on CUDA. kFloat32 keeps everything in the
 // parameters' type (float32 in training). kBFloat16 stores the GEMM inputs,
@@ -78,7 +61,16 @@ class FieldMLPImpl : public torch::nn::Module {
  public:
   explicit FieldMLPImpl(const FieldMLPOptions& options);
 
-  // uvd [N,3]; condition [N, condition_channels] (undefined when 0 channels).
+  // The positional encoding of uvd [N,3] in the layers' type, with its
+  // derivatives when a Jacobian is wanted. Fields with the same encoding and
+  // precision options can share it (ExpressionNetwork computes it once for
+  // both of its fields).
+  EncodedPositions encode(const at::Tensor& uvd, bool with_derivatives) const;
+
+  // condition [N, condition_channels] (undefined when 0 channels).
+  at::Tensor forward(const EncodedPositions& encoded, const at::Tensor& condition);
+  FieldWithJacobian forward_with_jacobian(const EncodedPositions& encoded, const at::Tensor& condition);
+  // The same from uvd [N,3].
   at::Tensor forward(const at::Tensor& uvd, const at::Tensor& condition);
   FieldWithJacobian forward_with_jacobian(const at::Tensor& uvd, const at::Tensor& condition);
 
@@ -86,8 +78,12 @@ class FieldMLPImpl : public torch::nn::Module {
 
  private:
   at::ScalarType layer_type(const at::Tensor& uvd) const;
+  void check_encoded(const EncodedPositions& encoded, bool with_derivatives) const;
   // Pre-activation, with the first layer's weight already in the layers' type.
-  at::Tensor first_layer(const at::Tensor& uvd, const at::Tensor& condition, const at::Tensor& weight) const;
+  at::Tensor first_layer(const EncodedPositions& encoded, const at::Tensor& condition, const at::Tensor& weight) const;
+  // The output layer's weight and bias in the layers' type, rows padded to
+  // an aligned count (positional_encoding.h says why).
+  std::pair<at::Tensor, at::Tensor> output_layer(at::ScalarType type) const;
 
   FieldMLPOptions options_;
   torch::nn::Linear input_{nullptr}, hidden_{nullptr}, output_{nullptr};

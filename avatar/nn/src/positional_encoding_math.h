@@ -1,0 +1,50 @@
+#pragma once
+// Per-element math of encode_positions (tega/nn/positional_encoding.h),
+// shared by the CPU loops and the CUDA kernels. Feature f of one axis, at
+// x = scale·c for the axis's coordinate c:
+//   f = 0:       x                 d/dc = scale
+//   f = 1 + 2k:  sin(ω x)          d/dc = ω scale cos(ω x),   d²/dc² = -(ω scale)² sin(ω x)
+//   f = 2 + 2k:  cos(ω x)          d/dc = -ω scale sin(ω x),  d²/dc² = -(ω scale)² cos(ω x)
+// with ω = π 2^k. The second derivative is what the backward pass needs for
+// the gradient that reaches c through the first.
+
+#include <cmath>
+
+#include "tega/avatar/host_device.h"
+
+namespace tega::nn::positional_encoding {
+
+constexpr int kAxes = 3;
+constexpr double kPi = 3.141592653589793;
+
+template <typename T>
+struct Feature {
+  T value, first, second;  // the feature and its derivatives w.r.t. the coordinate
+};
+
+template <typename T>
+TEGA_HD void sin_cos(T phase, T* s, T* c) {
+#if defined(__CUDA_ARCH__)
+  sincos(phase, s, c);  // CUDA's float and double overloads
+#else
+  *s = std::sin(phase);
+  *c = std::cos(phase);
+#endif
+}
+
+// Calls visit(f, feature) for f = 0 .. 2·frequencies of one axis (one sine
+// and cosine per octave).
+template <typename T, typename Visit>
+TEGA_HD void visit_features(int frequencies, T coordinate, T scale, Visit&& visit) {
+  const T x = coordinate * scale;
+  visit(0, Feature<T>{x, scale, T(0)});
+  for (int k = 0; k < frequencies; ++k) {
+    const T omega = T(kPi) * T(int64_t(1) << k), rate = omega * scale;
+    T s, c;
+    sin_cos(x * omega, &s, &c);
+    visit(1 + 2 * k, Feature<T>{s, rate * c, -rate * rate * s});
+    visit(2 + 2 * k, Feature<T>{c, -rate * s, -rate * rate * c});
+  }
+}
+
+}  // namespace tega::nn::positional_encoding
