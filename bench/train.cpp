@@ -9,9 +9,11 @@
 // 3072x2048) is measured directly. The field and shading are active from the
 // first iteration (no warm-up), as in the steady state of a real run.
 //
-// --trace (CUDA builds) records three more, unprofiled iterations with the
-// PyTorch (Kineto) profiler into a Chrome trace; bench/trace_summary.py turns
-// it into GPU milliseconds per part of the model, forward and backward.
+// The profiled iterations are followed by as many unprofiled ones, timed by
+// the wall clock as a user's run sees them. --trace (CUDA builds) records
+// three more with the PyTorch (Kineto) profiler into a Chrome trace;
+// bench/trace_summary.py turns it into GPU milliseconds per part of the
+// model, forward and backward.
 
 #include <ATen/ATen.h>
 
@@ -110,8 +112,14 @@ int main(int argc, char** argv) {
     }
     std::printf("| **total** | **%.2f** |\n", total);
     std::printf("(the profile waits for the GPU between parts; training without --profile overlaps them)\n");
+    // The same number of iterations as training runs them (no waits between
+    // parts; one sync per step for the loss): the time a user sees.
+    options.profile = false;
+    options.iterations += iterations;
+    const auto unprofiled = tega::trainer::train(data, run, options, {.resume = true});
+    std::printf("unprofiled: %.2f ms / iteration over %lld iterations (wall clock)\n",
+                1e3 * unprofiled.loop_seconds / double(iterations), static_cast<long long>(iterations));
     if (!trace.empty()) {
-      options.profile = false;
       options.iterations += 3;
       trace_to(trace, [&] { tega::trainer::train(data, run, options, {.resume = true}); });
       std::printf("trace of 3 iterations: %s\n", trace.c_str());

@@ -158,6 +158,7 @@ class Run {
       if (iteration_ % options_.checkpoint_every == 0 && iteration_ < last) save();
     }
     profiler_.stop();
+    summary.loop_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     save();
     summary.iterations = iteration_;
     summary.gaussians = model_.gaussians.size();
