@@ -10,10 +10,11 @@ namespace tega::splat::cuda {
 namespace {
 
 constexpr int kForwardThreads = kTileSize * kTileSize;  // one pixel each
-// The backward pass gives each thread four pixels, so that a splat read from
-// shared memory and each warp reduction serve 128 pixels (at two pixels a
-// thread, the reductions were a third of its instructions).
-constexpr int kPixelsPerThread = 4;
+// The backward pass gives each thread two pixels, so that a splat read from
+// shared memory and each warp reduction serve 64 pixels. (Four pixels a
+// thread halve the reductions but cost more than they save: fewer resident
+// warps, and a warp's block of 128 pixels touches more splats.)
+constexpr int kPixelsPerThread = 2;
 constexpr int kBackwardThreads = kTileSize * kTileSize / kPixelsPerThread;
 constexpr unsigned kFullWarp = 0xffffffffu;
 constexpr float kLog2e = 1.4426950408889634f;
@@ -271,18 +272,24 @@ __device__ __forceinline__ float warp_reduce_scatter(const float (&v)[kFields]) 
   return total + __shfl_xor_sync(kFullWarp, total, 1);
 }
 
-// Warp w blends rows [8w, 8w + 8) of the tile, and lane l column l % 16 of
-// its rows l / 16 + 2k, k < 4. Like the forward pass, each warp walks the
-// list on its own, from the last entry its pixels blended. kWithDepth: the
-// loss depends on the depth image.
+// Each warp blends an 8x8 block of its tile (the squarest of 64 pixels, as in
+// the forward pass); lane l takes column l % 8 of the block's rows l / 8 and
+// l / 8 + 4. Like the forward pass, each warp walks the list on its own, from
+// the last entry its pixels blended. kWithDepth: the loss depends on the
+// depth image.
+constexpr int kBackwardCols = 8, kBackwardRows = 8;
+static_assert(kBackwardCols * kBackwardRows == 32 * kPixelsPerThread && kTileSize % kBackwardCols == 0 &&
+                  kBackwardThreads / 32 == (kTileSize / kBackwardCols) * (kTileSize / kBackwardRows),
+              "the warps' blocks must tile a tile");
+
 template <bool kWithDepth>
 __global__ void __launch_bounds__(kBackwardThreads) render_backward_kernel(RasterInputs<float> in,
                                                                            const Splat2D<float>* splats,
                                                                            TileBins bins, ImageBuffers<float> image,
                                                                            ImageGradients<float> grads,
                                                                            Splat2D<float>* splat_grads) {
-  constexpr int kWarps = kBackwardThreads / 32, kBlockRows = kTileSize / kWarps, kRowStep = 32 / kTileSize;
-  static_assert(kBlockRows == kRowStep * kPixelsPerThread, "a warp's lanes cover its rows");
+  constexpr int kWarps = kBackwardThreads / 32, kBlocksAcross = kTileSize / kBackwardCols;
+  constexpr int kRowStep = 32 / kBackwardCols;  // rows between a thread's pixels
   __shared__ BlendSplat batches[kWarps][32];
   __shared__ int32_t batch_ids[kWarps][32];
   const ImageGeometry g = in.geometry;
@@ -291,9 +298,9 @@ __global__ void __launch_bounds__(kBackwardThreads) render_backward_kernel(Raste
   const unsigned lane = threadIdx.x % 32, warp = threadIdx.x / 32;
   BlendSplat* batch = batches[warp];
   int32_t* ids = batch_ids[warp];
-  const int32_t block_x0 = int32_t(blockIdx.x) * kTileSize;
-  const int32_t block_y0 = int32_t(blockIdx.y) * kTileSize + kBlockRows * int32_t(warp);
-  const int32_t x = block_x0 + int32_t(lane % kTileSize);
+  const int32_t block_x0 = int32_t(blockIdx.x) * kTileSize + kBackwardCols * int32_t(warp % kBlocksAcross);
+  const int32_t block_y0 = int32_t(blockIdx.y) * kTileSize + kBackwardRows * int32_t(warp / kBlocksAcross);
+  const int32_t x = block_x0 + int32_t(lane % kBackwardCols);
   const float px = float(x);
   const float* bg = in.background;
 
@@ -303,7 +310,7 @@ __global__ void __launch_bounds__(kBackwardThreads) render_backward_kernel(Raste
   int32_t thread_last = 0;
 #pragma unroll
   for (int p = 0; p < kPixelsPerThread; ++p) {
-    const int32_t y = block_y0 + int32_t(lane / kTileSize) + kRowStep * p;
+    const int32_t y = block_y0 + int32_t(lane / kBackwardCols) + kRowStep * p;
     py[p] = float(y);
     float grad_alpha_out = 0.0f, final_transmittance = 0.0f;
     st[p] = {};
@@ -335,7 +342,7 @@ __global__ void __launch_bounds__(kBackwardThreads) render_backward_kernel(Raste
     if (k >= begin) {
       const int32_t id = bins.gaussian_ids[k];
       const Splat2D<float> sp = load_splat(splats + id);
-      used = block_may_touch(sp, g, block_x0, block_y0, kTileSize, kBlockRows);
+      used = block_may_touch(sp, g, block_x0, block_y0, kBackwardCols, kBackwardRows);
       if (used) {
         batch[lane] = blend_splat(sp);
         ids[lane] = id;
