@@ -76,11 +76,12 @@ EncodedPositions forward_cpu(const PositionalEncoding& encoding, const at::Tenso
       for (int64_t p = begin; p < end; ++p)
         for (int a = 0; a < kAxes; ++a) {
           scalar_t* derivative_row = d ? d + (a * n + p) * derivative_width : nullptr;
-          visit_features(int(encoding.frequencies), c[kAxes * p + a], axis_scale_of<scalar_t>(encoding, a),
-                         [&](int f, const Feature<scalar_t>& feature) {
-                           e[p * width + kAxes * f + a] = feature.value;
-                           if (derivative_row) derivative_row[f] = feature.first;
-                         });
+          for (int f = 0; f < encoding.features(); ++f) {
+            const Feature<scalar_t> feature =
+                encoding_feature(f, c[kAxes * p + a], axis_scale_of<scalar_t>(encoding, a));
+            e[p * width + kAxes * f + a] = feature.value;
+            if (derivative_row) derivative_row[f] = feature.first;
+          }
         }
     });
   });
@@ -102,11 +103,12 @@ at::Tensor backward_cpu(const PositionalEncoding& encoding, const at::Tensor& uv
         for (int a = 0; a < kAxes; ++a) {
           const scalar_t* derivative_row = gd ? gd + (a * n + p) * derivative_width : nullptr;
           scalar_t sum = 0;
-          visit_features(int(encoding.frequencies), c[kAxes * p + a], axis_scale_of<scalar_t>(encoding, a),
-                         [&](int f, const Feature<scalar_t>& feature) {
-                           sum += ge[p * width + kAxes * f + a] * feature.first;
-                           if (derivative_row) sum += derivative_row[f] * feature.second;
-                         });
+          for (int f = 0; f < encoding.features(); ++f) {
+            const Feature<scalar_t> feature =
+                encoding_feature(f, c[kAxes * p + a], axis_scale_of<scalar_t>(encoding, a));
+            sum += ge[p * width + kAxes * f + a] * feature.first;
+            if (derivative_row) sum += derivative_row[f] * feature.second;
+          }
           g[kAxes * p + a] = sum;
         }
     });

@@ -32,19 +32,19 @@ TEGA_HD void sin_cos(T phase, T* s, T* c) {
 #endif
 }
 
-// Calls visit(f, feature) for f = 0 .. 2·frequencies of one axis (one sine
-// and cosine per octave).
-template <typename T, typename Visit>
-TEGA_HD void visit_features(int frequencies, T coordinate, T scale, Visit&& visit) {
+// Feature f of one axis at its coordinate. Each call evaluates one sine and
+// cosine: the CUDA kernels compute the features of a row in the order they
+// store them, not octave by octave.
+template <typename T>
+TEGA_HD Feature<T> encoding_feature(int f, T coordinate, T scale) {
   const T x = coordinate * scale;
-  visit(0, Feature<T>{x, scale, T(0)});
-  for (int k = 0; k < frequencies; ++k) {
-    const T omega = T(kPi) * T(int64_t(1) << k), rate = omega * scale;
-    T s, c;
-    sin_cos(x * omega, &s, &c);
-    visit(1 + 2 * k, Feature<T>{s, rate * c, -rate * rate * s});
-    visit(2 + 2 * k, Feature<T>{c, -rate * s, -rate * rate * c});
-  }
+  if (f == 0) return {x, scale, T(0)};
+  const int k = (f - 1) / 2;
+  const T omega = T(kPi) * T(int64_t(1) << k), rate = omega * scale;
+  T s, c;
+  sin_cos(x * omega, &s, &c);
+  if ((f - 1) % 2 == 0) return {s, rate * c, -rate * rate * s};
+  return {c, -rate * s, -rate * rate * c};
 }
 
 }  // namespace tega::nn::positional_encoding
