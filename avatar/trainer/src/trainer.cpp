@@ -30,6 +30,8 @@
 #include "tega/trainer/step_profiler.h"
 #include "tega/trainer/view_loader.h"
 
+#include "step_readout.h"
+
 namespace tega::trainer {
 namespace fs = std::filesystem;
 
@@ -134,15 +136,23 @@ class Run {
     double window_loss = 0, window_psnr = 0;
     int window = 0;
     TrainSummary summary;
+    // Adds a finished step's values to the log window; stops on NaN/Inf.
+    const auto take = [&](const std::optional<StepValues>& values) {
+      if (!values) return;
+      if (!values->finite) report_non_finite(*values);
+      window_loss += values->loss;
+      window_psnr += -10.0 * std::log10(std::max(values->mse, 1e-12));
+      ++window;
+    };
     while (iteration_ < last) {
       profiler_.section("data");
       const LoadedView view = loader.next();
-      const auto [loss, mse] = step(view);
+      step(view, take);
       ++iteration_;
-      window_loss += loss;
-      window_psnr += -10.0 * std::log10(std::max(mse, 1e-12));
-      ++window;
-      if (iteration_ % options_.log_every == 0 || iteration_ == last) {
+      const bool log_due = iteration_ % options_.log_every == 0 || iteration_ == last;
+      const bool checkpoint_due = iteration_ % options_.checkpoint_every == 0 && iteration_ < last;
+      if (log_due || checkpoint_due) take(readout_.pop());
+      if (log_due) {
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         const double rate = static_cast<double>(iteration_ - first) / std::max(seconds, 1e-9);
         summary.final_loss = window_loss / window;
@@ -155,7 +165,7 @@ class Run {
         window_loss = window_psnr = 0;
         window = 0;
       }
-      if (iteration_ % options_.checkpoint_every == 0 && iteration_ < last) save();
+      if (checkpoint_due) save();
     }
     profiler_.stop();
     summary.loop_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -194,8 +204,11 @@ class Run {
     return it->second;
   }
 
-  // Forward, backward and update on one view. Returns (loss, mse).
-  std::pair<double, double> step(const LoadedView& loaded) {
+  // Forward, backward and update on one view. The step's loss, MSE and
+  // finite check are queued in readout_; the previous step's go to `take`
+  // once this step's work is queued (step_readout.h says why).
+  template <class Take>
+  void step(const LoadedView& loaded, Take&& take) {
     RECORD_FUNCTION("tega::step", std::vector<c10::IValue>());
     const Camera& camera = dataset_.rig.cameras[loaded.view.camera];
     const Phase p = phase();
@@ -229,8 +242,8 @@ class Run {
     if (p.deformation && options_.loss.smoothness_samples > 0) {
       RECORD_FUNCTION("tega::smoothness", std::vector<c10::IValue>());
       const at::Tensor samples =
-          nn::sample_smoothness_uvd(options_.loss.smoothness_samples, at::TensorOptions(at::kFloat), generator_)
-              .to(device_);
+          to_device(nn::sample_smoothness_uvd(options_.loss.smoothness_samples, at::TensorOptions(at::kFloat),
+                                              generator_));
       const at::Tensor jacobians = model_.network->deform(samples, posed.latents, true).jacobian;
       loss = loss + schedules::smoothness_weight(options_.loss, iteration_, options_.iterations) *
                         nn::jacobian_smoothness_loss(jacobians, nn::Reduction::mean);
@@ -240,11 +253,12 @@ class Run {
     profiler_.section("backward");
     adam_.zero_grad();
     loss.backward();
-    // One device sync per step: loss, MSE and the NaN/Inf check together.
-    const at::Tensor values = at::stack({loss.detach().to(at::kDouble), mse.to(at::kDouble),
-                                         all_finite(loss).to(at::kDouble)}).cpu();
-    const double* v = values.data_ptr<double>();
-    if (v[2] == 0.0) report_non_finite(loaded);
+    // A NaN/Inf is reported one step late: the step that made it has updated
+    // the parameters by then, but nothing is saved before its check (the loop
+    // takes the last step's values before every save, and the checkpoint
+    // writer refuses non-finite tensors).
+    take(readout_.pop());
+    readout_.push(loss, mse, all_finite(loss), iteration_ + 1, loaded.view);
 
     profiler_.section("optimizer");
     {
@@ -258,7 +272,13 @@ class Run {
 
     profiler_.section("densification");
     densify_if_due(camera);
-    return {v[0], v[1]};
+  }
+
+  // A host tensor on the training device without waiting for the GPU (a
+  // blocking copy waits for every queued kernel).
+  at::Tensor to_device(const at::Tensor& host) const {
+    if (!device_.is_cuda()) return host.to(device_);
+    return host.pin_memory().to(device_, /*non_blocking=*/true);
   }
 
   // Whether the loss and every gradient are finite, as a 0-d bool tensor on the device.
@@ -270,9 +290,9 @@ class Run {
     return at::stack(finite).all();
   }
 
-  [[noreturn]] void report_non_finite(const LoadedView& loaded) const {
-    throw Error("iteration " + std::to_string(iteration_ + 1) + ": the loss or a gradient is NaN/Inf (camera " +
-                dataset_.rig.cameras[loaded.view.camera].name + ", frame " + dataset_.frames[loaded.view.frame].id +
+  [[noreturn]] void report_non_finite(const StepValues& values) const {
+    throw Error("iteration " + std::to_string(values.iteration) + ": the loss or a gradient is NaN/Inf (camera " +
+                dataset_.rig.cameras[values.view.camera].name + ", frame " + dataset_.frames[values.view.frame].id +
                 "); training stopped, the last checkpoint (iteration " + std::to_string(saved_iteration_) +
                 ") is intact");
   }
@@ -395,6 +415,7 @@ class Run {
   StepProfiler profiler_;
   int64_t iteration_ = 0;
   int64_t saved_iteration_ = 0;
+  StepReadout readout_;
 };
 
 }  // namespace

@@ -95,6 +95,29 @@ TEST(Trainer, ExistingRunIsNotOverwrittenByAccident) {
   }
 }
 
+// An absurd colour step size makes the second step's loss non-finite. The
+// run stops with an error naming it, and the checkpoint it leaves is the last
+// finite one.
+TEST(Trainer, NonFiniteStepStopsTrainingAndKeepsTheLastFiniteCheckpoint) {
+  tega::test::TempDir tmp;
+  tega::test::write_tiny_dataset(tmp / "data");
+  TrainOptions options = tiny_options();
+  options.learning_rates.sh_dc = 1e30;
+  options.checkpoint_every = 1;
+  try {
+    train(tmp / "data", tmp / "run", options, {});
+    FAIL() << "expected an error";
+  } catch (const tega::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("is NaN/Inf"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("the last checkpoint"), std::string::npos) << e.what();
+  }
+  const Checkpoint c = read_checkpoint(tmp / "run/checkpoint.safetensors");
+  EXPECT_GE(c.iteration(), 1);
+  EXPECT_LT(c.iteration(), options.iterations);
+  for (const auto& [name, tensor] : c.tensors)
+    if (tensor.is_floating_point()) EXPECT_TRUE(at::isfinite(tensor).all().item<bool>()) << name;
+}
+
 TEST(Trainer, BadDatasetFailsBeforeTraining) {
   tega::test::TempDir tmp;
   tega::test::write_tiny_dataset(tmp / "data");

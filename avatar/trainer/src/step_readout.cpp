@@ -1,0 +1,43 @@
+#include "step_readout.h"
+
+#include <ATen/ATen.h>
+#include <c10/core/impl/VirtualGuardImpl.h>
+#include <c10/util/Exception.h>
+
+#include <chrono>
+#include <thread>
+
+namespace tega::trainer {
+
+void StepReadout::push(const at::Tensor& loss, const at::Tensor& mse, const at::Tensor& finite, int64_t iteration,
+                       const View& view) {
+  TORCH_CHECK(!pending_, "StepReadout: a step is already queued");
+  const at::Tensor values = at::stack({loss.detach().to(at::kDouble), mse.detach().to(at::kDouble),
+                                       finite.to(at::kDouble)});
+  Pending p{{}, std::nullopt, iteration, view};
+  if (values.is_cpu()) {
+    p.host = values;
+  } else {
+    p.host = at::empty({3}, at::TensorOptions().dtype(at::kDouble).pinned_memory(true));
+    p.host.copy_(values, /*non_blocking=*/true);
+    const c10::impl::VirtualGuardImpl guard(values.device().type());
+    p.copied.emplace(values.device().type());
+    p.copied->record(guard.getStream(values.device()));
+  }
+  pending_ = std::move(p);
+}
+
+std::optional<StepValues> StepReadout::pop() {
+  if (!pending_) return std::nullopt;
+  // c10::Event has no blocking wait in every supported libtorch; the copy is
+  // normally done by now, so a poll costs nothing.
+  if (pending_->copied) {
+    while (!pending_->copied->query()) std::this_thread::sleep_for(std::chrono::microseconds(20));
+  }
+  const double* v = pending_->host.data_ptr<double>();
+  StepValues out{v[0], v[1], v[2] != 0.0, pending_->iteration, pending_->view};
+  pending_.reset();
+  return out;
+}
+
+}  // namespace tega::trainer
