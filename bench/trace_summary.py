@@ -9,6 +9,10 @@ TEGA_TRACE_SCOPE in avatar_model.cpp). Kernels launched by the autograd
 engine are charged, through the op's sequence number, to the scope of the
 forward op they differentiate, as "<part> backward".
 
+It also reports the GPU's idle time inside the steps and the longest idle
+gaps, each named by the part whose kernel ended it: the GPU waited there for
+the host (a synchronisation, or ops launched slower than they run).
+
     bench/trace_summary.py TRACE.json [--top 25]
 """
 import argparse
@@ -78,6 +82,7 @@ def main():
 
     per_part = collections.Counter()
     per_kernel = collections.Counter()
+    step_kernels = []  # (start, end, part)
     for k in kernels:
         op = op_by_external.get(k.get("args", {}).get("External id"))
         if op is None or not in_step(op):
@@ -85,6 +90,7 @@ def main():
         part = part_of(op)
         per_part[part] += k["dur"]
         per_kernel[(part, k["name"][:90])] += k["dur"]
+        step_kernels.append((k["ts"], k["ts"] + k["dur"], part))
 
     n = len(steps) or 1
     total = sum(per_part.values())
@@ -92,9 +98,34 @@ def main():
     print("| part | ms / iteration | share |\n|---|---:|---:|")
     for part, us in per_part.most_common():
         print(f"| {part} | {us / 1000 / n:.2f} | {100 * us / total:.1f}% |")
+    print_idle(step_kernels, n)
     print(f"\nTop {args.top} kernels:\n| part | kernel | ms / iteration |\n|---|---|---:|")
     for (part, name), us in per_kernel.most_common(args.top):
         print(f"| {part} | `{name}` | {us / 1000 / n:.2f} |")
+
+
+def print_idle(step_kernels, steps, shown=8):
+    """GPU idle time from the first step's first kernel to the last step's last, by the part that ended it."""
+    if not step_kernels:
+        return
+    step_kernels.sort()
+    gaps = []  # (length, part of the kernel after the gap)
+    busy_until = step_kernels[0][1]
+    for start, end, part in step_kernels[1:]:
+        if start > busy_until:
+            gaps.append((start - busy_until, part))
+        busy_until = max(busy_until, end)
+    idle = sum(g for g, _ in gaps)
+    span = busy_until - step_kernels[0][0]
+    print(f"\nGPU idle from the first step's first kernel to the last step's last: {idle / 1000 / steps:.2f} ms per iteration "
+          f"({100 * idle / span:.1f}% of {span / 1000 / steps:.2f} ms)")
+    by_part = collections.Counter()
+    for g, part in gaps:
+        by_part[part] += g
+    print("| idle before a kernel of | ms / iteration | longest gap ms |\n|---|---:|---:|")
+    for part, us in by_part.most_common(shown):
+        longest = max(g for g, p in gaps if p == part)
+        print(f"| {part} | {us / 1000 / steps:.2f} | {longest / 1000:.2f} |")
 
 
 if __name__ == "__main__":
