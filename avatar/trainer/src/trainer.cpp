@@ -217,6 +217,12 @@ class Run {
     profiler_.section("networks+jacobians");
     const FrameInput& frame = frame_input(loaded.view.frame);
     PosedGaussians posed = model_.pose(frame, p);
+    // Queued before the rasterizer, whose tile count waits for the GPU: the
+    // smoothness term's many small ops then launch while the fields' large
+    // kernels run, and autograd reaches their gradients behind the
+    // rasterizer's (after the image losses, they left the GPU idle ~10 ms a
+    // step at 4M Gaussians).
+    const at::Tensor smoothness = smoothness_term(p, posed);
 
     profiler_.section("rasterization");
     splat::RasterOutput raster;
@@ -239,15 +245,7 @@ class Run {
     }
     const double vgg_weight = schedules::vgg_weight(options_.loss, iteration_, options_.iterations);
     if (vgg_ && vgg_weight > 0) loss = loss + vgg_weight * (*vgg_)(rendered.unsqueeze(0), target.unsqueeze(0));
-    if (p.deformation && options_.loss.smoothness_samples > 0) {
-      RECORD_FUNCTION("tega::smoothness", std::vector<c10::IValue>());
-      const at::Tensor samples =
-          to_device(nn::sample_smoothness_uvd(options_.loss.smoothness_samples, at::TensorOptions(at::kFloat),
-                                              generator_));
-      const at::Tensor jacobians = model_.network->deform(samples, posed.latents, true).jacobian;
-      loss = loss + schedules::smoothness_weight(options_.loss, iteration_, options_.iterations) *
-                        nn::jacobian_smoothness_loss(jacobians, nn::Reduction::mean);
-    }
+    if (smoothness.defined()) loss = loss + smoothness;
     const at::Tensor mse = (rendered.detach() - target).pow(2).mean();
 
     profiler_.section("backward");
@@ -272,6 +270,18 @@ class Run {
 
     profiler_.section("densification");
     densify_if_due(camera);
+  }
+
+  // The weighted Jacobian smoothness loss on random uvd samples, or undefined
+  // when the field is off.
+  at::Tensor smoothness_term(const Phase& p, const PosedGaussians& posed) {
+    if (!p.deformation || options_.loss.smoothness_samples <= 0) return {};
+    RECORD_FUNCTION("tega::smoothness", std::vector<c10::IValue>());
+    const at::Tensor samples = to_device(
+        nn::sample_smoothness_uvd(options_.loss.smoothness_samples, at::TensorOptions(at::kFloat), generator_));
+    const at::Tensor jacobians = model_.network->deform(samples, posed.latents, true).jacobian;
+    return schedules::smoothness_weight(options_.loss, iteration_, options_.iterations) *
+           nn::jacobian_smoothness_loss(jacobians, nn::Reduction::mean);
   }
 
   // A host tensor on the training device without waiting for the GPU (a
