@@ -19,7 +19,9 @@ struct TrainSummary {
   int64_t iterations = 0;       // completed
   int64_t gaussians = 0;
   double seconds = 0;           // this invocation's training time
-  double loop_seconds = 0;      // of which the iterations (no final checkpoint or evaluation)
+  // The iterations after this invocation's first (which waits for the loader's
+  // first image), without the final checkpoint and evaluation.
+  double steady_seconds = 0;
   double final_loss = 0;
   double train_psnr = 0;        // mean over the last logged window
   double heldout_psnr = 0;      // train frames seen from the test cameras (novel view)
