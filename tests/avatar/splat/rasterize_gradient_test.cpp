@@ -22,6 +22,20 @@ double weighted_loss(const RasterOutput& out, const LossWeights& w) {
   return ((out.rgb * w.rgb).sum() + (out.alpha * w.alpha).sum() + (out.depth * w.depth).sum()).item<double>();
 }
 
+// The scene with its inputs replaced by copies that require gradients, which
+// go to `inputs` in Scene::inputs()'s order.
+Scene with_differentiable_inputs(const Scene& scene, std::vector<at::Tensor>& inputs) {
+  inputs = scene.inputs();
+  for (at::Tensor& t : inputs) t = t.clone().requires_grad_();
+  Scene differentiable = scene;
+  differentiable.means = inputs[0];
+  differentiable.covariances = inputs[1];
+  differentiable.colors = inputs[2];
+  differentiable.opacities = inputs[3];
+  differentiable.background = inputs[4];
+  return differentiable;
+}
+
 class GradientTest : public ::testing::TestWithParam<SceneSpec> {
  protected:
   void SetUp() override { at::set_num_threads(2); }
@@ -34,14 +48,8 @@ TEST_P(GradientTest, EveryInputMatchesFiniteDifferences) {
   const LossWeights weights{at::rand({c, h, w, 3}, opts) * 2 - 1, at::rand({c, h, w}, opts) * 2 - 1,
                             at::rand({c, h, w}, opts) * 2 - 1};
 
-  std::vector<at::Tensor> inputs = scene.inputs();
-  for (at::Tensor& t : inputs) t = t.clone().requires_grad_();
-  Scene differentiable = scene;
-  differentiable.means = inputs[0];
-  differentiable.covariances = inputs[1];
-  differentiable.colors = inputs[2];
-  differentiable.opacities = inputs[3];
-  differentiable.background = inputs[4];
+  std::vector<at::Tensor> inputs;
+  const Scene differentiable = with_differentiable_inputs(scene, inputs);
   const RasterOutput out = differentiable.render();
   const at::Tensor loss = (out.rgb * weights.rgb).sum() + (out.alpha * weights.alpha).sum() +
                           (out.depth * weights.depth).sum();
@@ -93,14 +101,8 @@ TEST(Rasterize, OutputsLeftOutOfTheLossActAsZeroWeights) {
   const int64_t c = int64_t(scene.cameras.size()), h = scene.settings.height, w = scene.settings.width;
   const at::Tensor weight_rgb = at::rand({c, h, w, 3}, at::TensorOptions().dtype(at::kDouble)) * 2 - 1;
   const auto gradients = [&](bool zero_weighted_outputs) {
-    std::vector<at::Tensor> inputs = scene.inputs();
-    for (at::Tensor& t : inputs) t = t.clone().requires_grad_();
-    Scene differentiable = scene;
-    differentiable.means = inputs[0];
-    differentiable.covariances = inputs[1];
-    differentiable.colors = inputs[2];
-    differentiable.opacities = inputs[3];
-    differentiable.background = inputs[4];
+    std::vector<at::Tensor> inputs;
+    const Scene differentiable = with_differentiable_inputs(scene, inputs);
     const RasterOutput out = differentiable.render();
     at::Tensor loss = (out.rgb * weight_rgb).sum();
     if (zero_weighted_outputs) loss = loss + (out.alpha * 0).sum() + (out.depth * 0).sum();
