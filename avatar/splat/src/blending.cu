@@ -240,36 +240,33 @@ __device__ __forceinline__ int reduced_field(unsigned lane) {
   return index_b < 3 && index_a < 5 ? ((lane & 16) ? 5 : 0) + index_a : -1;
 }
 
+// One step of the recursive halving: of the N values a lane carries, the
+// lanes with bit `offset` set keep the upper half (entries (N+1)/2 + i, 0
+// where N is odd) and the others the lower, each adding its partner's copy of
+// the half it keeps.
+template <int N>
+__device__ __forceinline__ void halve(const float (&in)[N], float (&out)[(N + 1) / 2], int offset) {
+  constexpr int kHalf = (N + 1) / 2;
+  const bool upper_half = threadIdx.x & offset;
+#pragma unroll
+  for (int i = 0; i < kHalf; ++i) {
+    const float upper = i + kHalf < N ? in[i + kHalf] : 0.0f;
+    const float send = upper_half ? in[i] : upper, keep = upper_half ? upper : in[i];
+    out[i] = keep + __shfl_xor_sync(kFullWarp, send, offset);
+  }
+}
+
 // Sums the ten fields over the warp by recursive halving: at each step a
 // lane keeps half of the values it carries and swaps the other half with
 // its partner, 12 shuffles in all (a shuffle tree per field takes 50).
 // Returns the total of field reduced_field(lane).
 __device__ __forceinline__ float warp_reduce_scatter(const float (&v)[kFields]) {
-  const unsigned lane = threadIdx.x % 32;
-  const bool h16 = lane & 16, h8 = lane & 8, h4 = lane & 4, h2 = lane & 2;
-  float a[5];  // fields 5·h16 + i
-#pragma unroll
-  for (int i = 0; i < 5; ++i) {
-    const float send = h16 ? v[i] : v[i + 5], keep = h16 ? v[i + 5] : v[i];
-    a[i] = keep + __shfl_xor_sync(kFullWarp, send, 16);
-  }
-  float b[3];  // entries 3·h8 + i of a (the sixth is empty)
-#pragma unroll
-  for (int i = 0; i < 3; ++i) {
-    const float upper = i + 3 < 5 ? a[i + 3] : 0.0f;
-    const float send = h8 ? a[i] : upper, keep = h8 ? upper : a[i];
-    b[i] = keep + __shfl_xor_sync(kFullWarp, send, 8);
-  }
-  float c[2];  // entries 2·h4 + i of b (the fourth is empty)
-#pragma unroll
-  for (int i = 0; i < 2; ++i) {
-    const float upper = i + 2 < 3 ? b[i + 2] : 0.0f;
-    const float send = h4 ? b[i] : upper, keep = h4 ? upper : b[i];
-    c[i] = keep + __shfl_xor_sync(kFullWarp, send, 4);
-  }
-  const float send = h2 ? c[0] : c[1], keep = h2 ? c[1] : c[0];
-  float total = keep + __shfl_xor_sync(kFullWarp, send, 2);
-  return total + __shfl_xor_sync(kFullWarp, total, 1);
+  float a[5], b[3], c[2], total[1];
+  halve(v, a, 16);  // fields 5·h16 + i
+  halve(a, b, 8);   // entries 3·h8 + i of a (the sixth is empty)
+  halve(b, c, 4);   // entries 2·h4 + i of b (the fourth is empty)
+  halve(c, total, 2);
+  return total[0] + __shfl_xor_sync(kFullWarp, total[0], 1);
 }
 
 // Each warp blends an 8x8 block of its tile (the squarest of 64 pixels, as in
