@@ -18,8 +18,12 @@
 
 #if defined(TEGA_TORCH_HAS_CUDA)
 #include <ATen/cuda/CUDAContext.h>
+#include <ATen/record_function.h>
 #include <c10/cuda/CUDACachingAllocator.h>
 #include <cuda_runtime_api.h>
+#include <torch/csrc/autograd/profiler_kineto.h>
+
+#include <set>
 
 namespace {
 
@@ -136,12 +140,51 @@ int profile(int64_t n, int width, int height) {
   return 0;
 }
 
+// `raster_bench trace N WIDTH HEIGHT FILE` records three forward+backward
+// passes (after warm-ups) with the PyTorch (Kineto) profiler into a Chrome
+// trace, each in a `tega::step` scope with the parts `tega::rasterize` and
+// `tega::loss`: bench/trace_summary.py then reports the GPU's idle time,
+// host overhead included, by part.
+int trace(int64_t n, int width, int height, const std::string& path) {
+  const Scene s = head_scene(n, width, height);
+  const auto [camera, settings] = head_view(width, height);
+  auto step = [&] {
+    RECORD_FUNCTION("tega::step", std::vector<c10::IValue>());
+    RasterOutput out;
+    {
+      RECORD_FUNCTION("tega::rasterize", std::vector<c10::IValue>());
+      out = rasterize(s.means, s.covariances, s.sh, s.opacities, s.background, {camera}, settings);
+    }
+    at::Tensor loss;
+    {
+      RECORD_FUNCTION("tega::loss", std::vector<c10::IValue>());
+      loss = (out.rgb - s.target).abs().mean();
+    }
+    torch::autograd::grad({loss}, {s.means, s.covariances, s.sh, s.opacities, s.background});
+    cudaDeviceSynchronize();  // as the timed runs: each pass starts on an idle GPU
+  };
+  for (int i = 0; i < kWarmups; ++i) step();
+  namespace profiler = torch::autograd::profiler;
+  using torch::profiler::impl::ActivityType;
+  const torch::profiler::impl::ProfilerConfig config(torch::profiler::impl::ProfilerState::KINETO);
+  const std::set<ActivityType> activities{ActivityType::CPU, ActivityType::CUDA};
+  profiler::prepareProfiler(config, activities);
+  profiler::enableProfiler(config, activities);
+  for (int i = 0; i < 3; ++i) step();
+  profiler::disableProfiler()->save(path);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc == 5 && std::string(argv[1]) == "profile") {
     if (!at::hasCUDA()) return 1;
     return profile(std::stoll(argv[2]), std::stoi(argv[3]), std::stoi(argv[4]));
+  }
+  if (argc == 6 && std::string(argv[1]) == "trace") {
+    if (!at::hasCUDA()) return 1;
+    return trace(std::stoll(argv[2]), std::stoi(argv[3]), std::stoi(argv[4]), argv[5]);
   }
   if (!at::hasCUDA()) {
     std::printf("raster_bench: no CUDA device, nothing to measure\n");

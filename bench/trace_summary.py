@@ -10,8 +10,10 @@ engine are charged, through the op's sequence number, to the scope of the
 forward op they differentiate, as "<part> backward".
 
 It also reports the GPU's idle time inside the steps and the longest idle
-gaps, each named by the part whose kernel ended it: the GPU waited there for
-the host (a synchronisation, or ops launched slower than they run).
+gaps, each named by the part whose kernel ended it and by the kernels around
+it: the GPU waited there for the host (a synchronisation, or ops launched
+slower than they run); and the time from a step's start on the host to its
+first kernel.
 
     bench/trace_summary.py TRACE.json [--top 25]
 """
@@ -90,7 +92,7 @@ def main():
         part = part_of(op)
         per_part[part] += k["dur"]
         per_kernel[(part, k["name"][:90])] += k["dur"]
-        step_kernels.append((k["ts"], k["ts"] + k["dur"], part))
+        step_kernels.append((k["ts"], k["ts"] + k["dur"], part, k["name"]))
 
     n = len(steps) or 1
     total = sum(per_part.values())
@@ -99,6 +101,7 @@ def main():
     for part, us in per_part.most_common():
         print(f"| {part} | {us / 1000 / n:.2f} | {100 * us / total:.1f}% |")
     print_idle(step_kernels, n)
+    print_host_lead(steps, step_kernels)
     print(f"\nTop {args.top} kernels:\n| part | kernel | ms / iteration |\n|---|---|---:|")
     for (part, name), us in per_kernel.most_common(args.top):
         print(f"| {part} | `{name}` | {us / 1000 / n:.2f} |")
@@ -109,23 +112,39 @@ def print_idle(step_kernels, steps, shown=8):
     if not step_kernels:
         return
     step_kernels.sort()
-    gaps = []  # (length, part of the kernel after the gap)
-    busy_until = step_kernels[0][1]
-    for start, end, part in step_kernels[1:]:
+    gaps = []  # (length, part of the kernel after the gap, the kernels before and after it)
+    busy_until, last_name = step_kernels[0][1], step_kernels[0][3]
+    for start, end, part, name in step_kernels[1:]:
         if start > busy_until:
-            gaps.append((start - busy_until, part))
-        busy_until = max(busy_until, end)
-    idle = sum(g for g, _ in gaps)
+            gaps.append((start - busy_until, part, (last_name, name)))
+        if end > busy_until:
+            busy_until, last_name = end, name
+    idle = sum(g for g, _, _ in gaps)
     span = busy_until - step_kernels[0][0]
     print(f"\nGPU idle from the first step's first kernel to the last step's last: {idle / 1000 / steps:.2f} ms per iteration "
           f"({100 * idle / span:.1f}% of {span / 1000 / steps:.2f} ms)")
     by_part = collections.Counter()
-    for g, part in gaps:
+    for g, part, _ in gaps:
         by_part[part] += g
     print("| idle before a kernel of | ms / iteration | longest gap ms |\n|---|---:|---:|")
     for part, us in by_part.most_common(shown):
-        longest = max(g for g, p in gaps if p == part)
+        longest = max(g for g, p, _ in gaps if p == part)
         print(f"| {part} | {us / 1000 / steps:.2f} | {longest / 1000:.2f} |")
+    print("\nLongest gaps:\n| ms | after | before |\n|---:|---|---|")
+    for g, _, (before, after) in sorted(gaps, reverse=True)[:shown]:
+        print(f"| {g / 1000:.3f} | `{before[:60]}` | `{after[:60]}` |")
+
+
+def print_host_lead(steps, step_kernels):
+    """Time from each step's start on the host to its first kernel on the GPU."""
+    starts = sorted(k[0] for k in step_kernels)
+    leads = []
+    for begin, end in steps:
+        i = bisect.bisect_left(starts, begin)
+        if i < len(starts) and starts[i] <= end:
+            leads.append(starts[i] - begin)
+    if leads:
+        print(f"\nFrom a step's start on the host to its first kernel: {sum(leads) / len(leads) / 1000:.3f} ms on average")
 
 
 if __name__ == "__main__":
