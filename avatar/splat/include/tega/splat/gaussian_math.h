@@ -27,12 +27,28 @@ TEGA_HD float math_sqrt(float x) { return sqrtf(x); }
 TEGA_HD double math_sqrt(double x) { return sqrt(x); }
 TEGA_HD float math_exp(float x) { return expf(x); }
 TEGA_HD double math_exp(double x) { return exp(x); }
-TEGA_HD float math_log(float x) { return logf(x); }
-TEGA_HD double math_log(double x) { return log(x); }
 TEGA_HD float math_floor(float x) { return floorf(x); }
 TEGA_HD double math_floor(double x) { return floor(x); }
 TEGA_HD float math_ceil(float x) { return ceilf(x); }
 TEGA_HD double math_ceil(double x) { return ceil(x); }
+// For bounds that carry a margin: the GPU's one-instruction approximations
+// (relative error about 1e-7), exact elsewhere.
+TEGA_HD float bound_reciprocal(float x) {
+#ifdef __CUDA_ARCH__
+  return __fdividef(1.0f, x);
+#else
+  return 1.0f / x;
+#endif
+}
+TEGA_HD double bound_reciprocal(double x) { return 1.0 / x; }
+TEGA_HD float bound_log(float x) {
+#ifdef __CUDA_ARCH__
+  return __logf(x);
+#else
+  return logf(x);
+#endif
+}
+TEGA_HD double bound_log(double x) { return log(x); }
 template <typename T>
 TEGA_HD T math_min(T a, T b) { return a < b ? a : b; }
 template <typename T>
@@ -334,7 +350,7 @@ TEGA_HD bool project_covariance(const CameraParams<T>& cam, const ImageGeometry&
 // The level of q = dᵀ conic d at which opacity·G falls to kMinAlpha.
 template <typename T>
 TEGA_HD T splat_level(const Splat2D<T>& sp) {
-  return T(2) * math_log(sp.opacity / T(kMinAlpha));
+  return T(2) * bound_log(sp.opacity * T(1.0 / kMinAlpha));  // the callers' margins cover its rounding
 }
 
 // Half-extents (px) of the ellipse where opacity·G ≥ kMinAlpha, and the
@@ -371,13 +387,16 @@ TEGA_HD bool splat_may_touch(const Splat2D<T>& sp, T level, T x0, T y0, T x1, T 
   const T a = sp.conic_a, b = sp.conic_b, c = sp.conic_c;
   // With the centre outside, the minimum of q = a dx² + 2b dx dy + c dy²
   // lies on an edge: on x = const at dy = -b dx / c (clamped), and so on.
+  // q at a point near the minimiser exceeds the minimum only to second order,
+  // so approximate reciprocals do.
+  const T b_over_c = b * bound_reciprocal(c), b_over_a = b * bound_reciprocal(a);
   T q_min = T(0);
   for (int e = 0; e < 4; ++e) {
     const bool vertical = e < 2;
     const T fixed = vertical ? (e == 0 ? dx0 : dx1) : (e == 2 ? dy0 : dy1);
     const T lo = vertical ? dy0 : dx0, hi = vertical ? dy1 : dx1;
     const T along_curv = vertical ? c : a, fixed_curv = vertical ? a : c;
-    const T along = math_min(math_max(-b * fixed / along_curv, lo), hi);
+    const T along = math_min(math_max(-fixed * (vertical ? b_over_c : b_over_a), lo), hi);
     const T q = fixed_curv * fixed * fixed + (T(2) * b * fixed + along_curv * along) * along;
     q_min = e == 0 ? q : math_min(q_min, q);
   }
