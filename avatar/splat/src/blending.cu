@@ -162,7 +162,7 @@ __global__ void __launch_bounds__(kForwardThreads) render_forward_kernel(RasterI
   image.rgb[3 * pixel + 1] = green + transmittance * bg[1];
   image.rgb[3 * pixel + 2] = blue + transmittance * bg[2];
   image.alpha[pixel] = 1.0f - transmittance;
-  image.depth[pixel] = depth;
+  image.depth[pixel] = expected_depth(depth, 1.0f - transmittance);
   image.final_transmittance[pixel] = transmittance;
   image.last[pixel] = last;
 }
@@ -315,9 +315,11 @@ __global__ void __launch_bounds__(kBackwardThreads) render_backward_kernel(Raste
     if (x < g.width && y < g.height) {
       const int64_t pixel = (int64_t(blockIdx.z) * g.height + y) * g.width + x;
       for (int ch = 0; ch < 3; ++ch) st[p].grad_rgb[ch] = grads.rgb[3 * pixel + ch];
-      if constexpr (kWithDepth) st[p].grad_depth = grads.depth[pixel];
       grad_alpha_out = grads.alpha[pixel];
       final_transmittance = image.final_transmittance[pixel];
+      if constexpr (kWithDepth)
+        st[p].grad_depth =
+            expected_depth_backward(grads.depth[pixel], image.depth[pixel], 1.0f - final_transmittance, grad_alpha_out);
       last[p] = image.last[pixel];
     }
     const float background_dot = bg[0] * st[p].grad_rgb[0] + bg[1] * st[p].grad_rgb[1] + bg[2] * st[p].grad_rgb[2];

@@ -27,10 +27,11 @@ TileOrigin tile_origin(const ImageGeometry& g, int64_t tile) {
 
 template <typename T>
 void project(const RasterInputs<T>& in, const ProjectedBuffers<T>& out) {
-  const int64_t n = in.num_gaussians;
+  const int64_t n = in.num_gaussians, row = int64_t(3) * in.sh_coefficients;
   at::parallel_for(0, in.num_projected(), 1024, [&](int64_t begin, int64_t end) {
     for (int64_t i = begin; i < end; ++i)
-      out.radii[i] = project_one(in, int32_t(i / n), i % n, out.splats[i], out.rects[i]);
+      out.radii[i] = project_one(in, int32_t(i / n), i % n, in.colors + row * (i % n), out.splats[i], out.rects[i],
+                                 out.color_jacobians ? out.color_jacobians + i : nullptr);
   });
 }
 
@@ -93,7 +94,7 @@ void render_forward(const RasterInputs<T>& in, const Splat2D<T>* splats, const T
           const int64_t pixel = (int64_t(o.camera) * g.height + py) * g.width + px;
           for (int ch = 0; ch < 3; ++ch) image.rgb[3 * pixel + ch] = acc.rgb[ch] + acc.transmittance * bg[ch];
           image.alpha[pixel] = T(1) - acc.transmittance;
-          image.depth[pixel] = acc.depth;
+          image.depth[pixel] = expected_depth(acc.depth, T(1) - acc.transmittance);
           image.final_transmittance[pixel] = acc.transmittance;
           image.last[pixel] = acc.last;
         }
@@ -121,8 +122,10 @@ void render_backward(const RasterInputs<T>& in, const Splat2D<T>* splats, const 
           PixelBackward<T> st;
           for (int ch = 0; ch < 3; ++ch) st.grad_rgb[ch] = grads.rgb[3 * pixel + ch];
           st.grad_alpha_out = grads.alpha[pixel];
-          st.grad_depth = grads.depth ? grads.depth[pixel] : T(0);
           st.final_transmittance = image.final_transmittance[pixel];
+          st.grad_depth = grads.depth ? expected_depth_backward(grads.depth[pixel], image.depth[pixel],
+                                                                T(1) - st.final_transmittance, st.grad_alpha_out)
+                                      : T(0);
           st.transmittance = st.final_transmittance;
           st.background_dot = bg[0] * st.grad_rgb[0] + bg[1] * st.grad_rgb[1] + bg[2] * st.grad_rgb[2];
           for (int32_t k = first + image.last[pixel] - 1; k >= first; --k)
@@ -142,11 +145,11 @@ void render_backward(const RasterInputs<T>& in, const Splat2D<T>* splats, const 
 
 template <typename T>
 void project_backward(const RasterInputs<T>& in, const int32_t* radii, const Splat2D<T>* splat_grads,
-                      const InputGradients<T>& out) {
+                      const ColorJacobian<T>* color_jacobians, const InputGradients<T>& out) {
   at::parallel_for(0, in.num_gaussians, 256, [&](int64_t begin, int64_t end) {
     const int64_t row = int64_t(3) * in.sh_coefficients;
     for (int64_t g = begin; g < end; ++g)
-      project_backward_one(in, radii, splat_grads, g, in.colors + row * g, out.colors + row * g, out);
+      project_backward_one(in, radii, splat_grads, color_jacobians, g, out.colors + row * g, out);
   });
 }
 
@@ -158,7 +161,7 @@ void project_backward(const RasterInputs<T>& in, const int32_t* radii, const Spl
   template void render_backward<T>(const RasterInputs<T>&, const Splat2D<T>*, const TileBins&,         \
                                    const ImageBuffers<T>&, const ImageGradients<T>&, Splat2D<T>*);     \
   template void project_backward<T>(const RasterInputs<T>&, const int32_t*, const Splat2D<T>*,         \
-                                    const InputGradients<T>&);
+                                    const ColorJacobian<T>*, const InputGradients<T>&);
 TEGA_SPLAT_INSTANTIATE(float)
 TEGA_SPLAT_INSTANTIATE(double)
 #undef TEGA_SPLAT_INSTANTIATE

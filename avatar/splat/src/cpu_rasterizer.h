@@ -26,8 +26,9 @@ template <typename T>
 void render_backward(const RasterInputs<T>& in, const Splat2D<T>* splats, const TileBins& bins,
                      const ImageBuffers<T>& image, const ImageGradients<T>& grads, Splat2D<T>* splat_grads);
 
+// color_jacobians: what project() kept (null unless the colours are SH).
 template <typename T>
 void project_backward(const RasterInputs<T>& in, const int32_t* radii, const Splat2D<T>* splat_grads,
-                      const InputGradients<T>& out);
+                      const ColorJacobian<T>* color_jacobians, const InputGradients<T>& out);
 
 }  // namespace tega::splat::cpu

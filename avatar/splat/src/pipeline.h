@@ -39,6 +39,7 @@ struct ProjectedBuffers {
   Splat2D<T>* splats = nullptr;
   TileRect* rects = nullptr;
   int32_t* radii = nullptr;
+  ColorJacobian<T>* color_jacobians = nullptr;  // SH colours only (else null)
 };
 
 // Each tile's run [begin, end) in the list of projected-Gaussian ids, which
@@ -54,7 +55,7 @@ template <typename T>
 struct ImageBuffers {
   T* rgb = nullptr;                  // [C, H, W, 3], background included
   T* alpha = nullptr;                // [C, H, W]
-  T* depth = nullptr;                // [C, H, W], Σ w z (not normalised)
+  T* depth = nullptr;                // [C, H, W], expected depth Σ w z / alpha (expected_depth)
   T* final_transmittance = nullptr;  // [C, H, W]
   int32_t* last = nullptr;           // [C, H, W], splats blended: 1 + last index in the tile list
 };
@@ -81,9 +82,13 @@ struct InputGradients {
 // ---------------------------------------------------------------------------
 // Per-Gaussian steps that both pipelines run once per index.
 
-// Projects Gaussian g into camera c, colour included. Returns the radius (0: culled).
+// Projects Gaussian g into camera c, colour included. With SH colours, g's
+// coefficients are read from sh_row (g's row of in.colors, or a copy of it
+// that the caller moved) and the colour's Jacobian for the backward pass is
+// written to color_jacobian. Returns the radius (0: culled).
 template <typename T>
-TEGA_HD int32_t project_one(const RasterInputs<T>& in, int32_t c, int64_t g, Splat2D<T>& sp, TileRect& rect) {
+TEGA_HD int32_t project_one(const RasterInputs<T>& in, int32_t c, int64_t g, const T* sh_row, Splat2D<T>& sp,
+                            TileRect& rect, ColorJacobian<T>* color_jacobian) {
   const CameraParams<T>& cam = in.cameras[c];
   const int32_t radius =
       project_gaussian(cam, in.geometry, in.projection, in.means + 3 * g, in.covariances + 6 * g, in.opacities[g], sp, rect);
@@ -92,7 +97,7 @@ TEGA_HD int32_t project_one(const RasterInputs<T>& in, int32_t c, int64_t g, Spl
   if (in.sh_coefficients > 0) {
     const T* mean = in.means + 3 * g;
     const T direction[3] = {mean[0] - cam.centre[0], mean[1] - cam.centre[1], mean[2] - cam.centre[2]};
-    sh_to_rgb(in.sh_degree, in.colors + int64_t(3) * in.sh_coefficients * g, direction, rgb);
+    sh_to_rgb(in.sh_degree, sh_row, direction, rgb, *color_jacobian);
   } else {
     const T* src = in.colors + in.color_camera_stride * c + 3 * g;
     rgb[0] = src[0];
@@ -107,12 +112,13 @@ TEGA_HD int32_t project_one(const RasterInputs<T>& in, int32_t c, int64_t g, Spl
 
 // Backward of project_one for Gaussian g over every camera: reads the splat
 // gradients [C * N] and writes (not adds) all of g's input gradients. With
-// SH colours, g's coefficients are read from sh_row and their gradient is
-// written to grad_sh_row (g's rows of in.colors and out.colors, or copies of
-// them that the caller moves).
+// SH colours, it reads the colour Jacobians [C * N] that the forward pass
+// kept and writes the coefficients' gradient to grad_sh_row (g's row of
+// out.colors, or a copy of it that the caller moves).
 template <typename T>
 TEGA_HD void project_backward_one(const RasterInputs<T>& in, const int32_t* radii, const Splat2D<T>* splat_grads,
-                                  int64_t g, const T* sh_row, T* grad_sh_row, const InputGradients<T>& out) {
+                                  const ColorJacobian<T>* color_jacobians, int64_t g, T* grad_sh_row,
+                                  const InputGradients<T>& out) {
   T grad_mean[3] = {T(0), T(0), T(0)};
   T grad_cov[6] = {T(0), T(0), T(0), T(0), T(0), T(0)};
   T grad_opacity = T(0);
@@ -139,11 +145,9 @@ TEGA_HD void project_backward_one(const RasterInputs<T>& in, const int32_t* radi
     const T* mean = in.means + 3 * g;
     if (sh) {
       const T direction[3] = {mean[0] - cam.centre[0], mean[1] - cam.centre[1], mean[2] - cam.centre[2]};
-      T grad_direction[3];
-      sh_to_rgb_backward(in.sh_degree, in.sh_coefficients, sh_row, direction, grad_rgb, sh_written, grad_sh,
-                         grad_direction);
+      sh_to_rgb_backward(in.sh_degree, in.sh_coefficients, color_jacobians[index], direction, grad_rgb, sh_written,
+                         grad_sh, grad_mean);  // d direction / d mean = I
       sh_written = true;
-      for (int k = 0; k < 3; ++k) grad_mean[k] += grad_direction[k];
     } else if (in.color_camera_stride == 0) {
       for (int ch = 0; ch < 3; ++ch) grad_rgb_shared[ch] += grad_rgb[ch];
     }

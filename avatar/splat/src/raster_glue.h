@@ -22,9 +22,10 @@ struct CallConfig {
 
 // What the forward pass returns and what the backward pass needs.
 struct ForwardTensors {
-  at::Tensor rgb, alpha, depth;  // depth: Σ w z, not normalised
+  at::Tensor rgb, alpha, depth;  // depth: expected depth Σ w z / alpha
   at::Tensor radii;              // [C, N] int32
   at::Tensor splats;             // [C * N, 12], Splat2D
+  at::Tensor color_jacobians;    // [C * N, 12], ColorJacobian; SH colours only (else undefined)
   at::Tensor final_transmittance, last;
   at::Tensor ranges, gaussian_ids;
 };
@@ -35,7 +36,7 @@ struct ImageGradTensors {
 };
 
 struct InputGradTensors {
-  at::Tensor means, covariances, colors, opacities;
+  at::Tensor means, covariances, colors, opacities, background;
 };
 
 // Fills the scalar-independent part of RasterInputs and the pointers of t.
@@ -59,6 +60,18 @@ RasterInputs<T> make_inputs(const RasterTensors& t, const CallConfig& config,
   in.geometry = make_geometry(s.width, s.height);
   in.projection = {s.near_plane, s.far_plane, s.antialiased};
   return in;
+}
+
+// [C * N, 12] for the ColorJacobians when the colours are SH, else undefined.
+template <typename T>
+at::Tensor empty_color_jacobians(const RasterInputs<T>& in, const at::TensorOptions& options) {
+  static_assert(sizeof(ColorJacobian<T>) == 12 * sizeof(T));
+  return in.sh_coefficients > 0 ? at::empty({in.num_projected(), 12}, options) : at::Tensor();
+}
+
+template <typename T>
+ColorJacobian<T>* color_jacobian_ptr(const at::Tensor& t) {
+  return t.defined() ? reinterpret_cast<ColorJacobian<T>*>(t.data_ptr<T>()) : nullptr;
 }
 
 template <typename T>

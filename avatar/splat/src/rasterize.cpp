@@ -17,8 +17,6 @@ namespace {
 using torch::autograd::AutogradContext;
 using torch::autograd::variable_list;
 
-constexpr double kMinExpectedDepthAlpha = 1e-10;
-
 glue::ForwardTensors run_forward(const glue::RasterTensors& t, const glue::CallConfig& config) {
   if (use_cuda_kernels(t.means, "tega splat")) {
 #if defined(TEGA_HAVE_CUDA) && defined(TEGA_TORCH_HAS_CUDA)
@@ -89,14 +87,14 @@ glue::CallConfig load_config(AutogradContext* ctx) {
 
 class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
  public:
-  // Returns rgb, alpha, Σ w z (unnormalised depth) and radii.
+  // Returns rgb, alpha, the expected depth and radii.
   static variable_list forward(AutogradContext* ctx, const at::Tensor& means, const at::Tensor& covariances,
                                const at::Tensor& colors, const at::Tensor& opacities, const at::Tensor& background,
                                const glue::CallConfig& config, const MeanGradientStats& stats) {
     const glue::RasterTensors t{means, covariances, colors, opacities, background};
     glue::ForwardTensors f = run_forward(t, config);
     ctx->save_for_backward({means, covariances, colors, opacities, background, f.radii, f.splats,
-                            f.final_transmittance, f.last, f.ranges, f.gaussian_ids});
+                            f.color_jacobians, f.depth, f.final_transmittance, f.last, f.ranges, f.gaussian_ids});
     save_config(ctx, config);
     if (stats.grad_norm_sum.defined()) {
       ctx->saved_data["stats_sum"] = stats.grad_norm_sum;
@@ -115,10 +113,12 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
     glue::ForwardTensors f;
     f.radii = saved[5];
     f.splats = saved[6];
-    f.final_transmittance = saved[7];
-    f.last = saved[8];
-    f.ranges = saved[9];
-    f.gaussian_ids = saved[10];
+    f.color_jacobians = saved[7];
+    f.depth = saved[8];
+    f.final_transmittance = saved[9];
+    f.last = saved[10];
+    f.ranges = saved[11];
+    f.gaussian_ids = saved[12];
     const at::Tensor& transmittance = f.final_transmittance;  // [C, H, W]
     const auto defined_or_zeros = [&](const at::Tensor& grad, at::IntArrayRef shape) {
       return grad.defined() ? grad.contiguous() : at::zeros(shape, transmittance.options());
@@ -134,9 +134,7 @@ class RasterizeFunction : public torch::autograd::Function<RasterizeFunction> {
       stats.visible_count = ctx->saved_data["stats_count"].toTensor();
     }
     const glue::InputGradTensors g = run_backward(t, load_config(ctx), f, grads, has_stats ? &stats : nullptr);
-    // d rgb / d background = final transmittance, per pixel.
-    const at::Tensor grad_background = (grads.rgb * f.final_transmittance.unsqueeze(-1)).sum({0, 1, 2});
-    return {g.means, g.covariances, g.colors, g.opacities, grad_background, at::Tensor(), at::Tensor()};
+    return {g.means, g.covariances, g.colors, g.opacities, g.background, at::Tensor(), at::Tensor()};
   }
 };
 
@@ -202,8 +200,7 @@ RasterOutput rasterize(const at::Tensor& means, const at::Tensor& covariances, c
   RasterOutput result;
   result.rgb = out[0];
   result.alpha = out[1];
-  const at::Tensor has_alpha = result.alpha > kMinExpectedDepthAlpha;
-  result.depth = at::where(has_alpha, out[2] / result.alpha.clamp_min(kMinExpectedDepthAlpha), at::zeros_like(out[2]));
+  result.depth = out[2];
   result.radii = out[3];
   result.visible = result.radii > 0;
   return result;

@@ -14,7 +14,6 @@ Splat2D<T>* splat_ptr(const at::Tensor& t) {
   return reinterpret_cast<Splat2D<T>*>(t.data_ptr<T>());
 }
 
-
 template <typename T>
 ForwardTensors forward(const RasterTensors& t, const CallConfig& config) {
   const auto cameras = camera_params<T>(config.cameras);
@@ -27,9 +26,10 @@ ForwardTensors forward(const RasterTensors& t, const CallConfig& config) {
   ForwardTensors f;
   f.splats = at::empty({c * n, kSplatWidth}, opts);
   f.radii = at::empty({c, n}, int_opts);
+  f.color_jacobians = empty_color_jacobians(in, opts);
   at::Tensor rects = at::empty({c * n, 4}, int_opts);
   const ProjectedBuffers<T> projected{splat_ptr<T>(f.splats), reinterpret_cast<TileRect*>(rects.data_ptr<int32_t>()),
-                                      f.radii.data_ptr<int32_t>()};
+                                      f.radii.data_ptr<int32_t>(), color_jacobian_ptr<T>(f.color_jacobians)};
   cpu::project(in, projected);
 
   f.ranges = at::empty({in.num_tiles(), 2}, int_opts);
@@ -56,7 +56,7 @@ InputGradTensors backward(const RasterTensors& t, const CallConfig& config, cons
   const RasterInputs<T> in = make_inputs<T>(t, config, cameras.data());
   const TileBins bins{saved.ranges.data_ptr<int32_t>(), saved.gaussian_ids.data_ptr<int32_t>(),
                       saved.gaussian_ids.numel()};
-  const ImageBuffers<T> image{nullptr, nullptr, nullptr, saved.final_transmittance.data_ptr<T>(),
+  const ImageBuffers<T> image{nullptr, nullptr, saved.depth.data_ptr<T>(), saved.final_transmittance.data_ptr<T>(),
                               saved.last.data_ptr<int32_t>()};
   at::Tensor splat_grads = at::empty_like(saved.splats);
   cpu::render_backward(in, splat_ptr<T>(saved.splats), bins, image,
@@ -64,15 +64,18 @@ InputGradTensors backward(const RasterTensors& t, const CallConfig& config, cons
                                          grads.depth.defined() ? grads.depth.data_ptr<T>() : nullptr},
                        splat_ptr<T>(splat_grads));
 
+  // d rgb / d background = final transmittance, per pixel.
   InputGradTensors out{at::empty_like(t.means), at::empty_like(t.covariances), at::empty_like(t.colors),
-                       at::empty_like(t.opacities)};
+                       at::empty_like(t.opacities),
+                       (grads.rgb * saved.final_transmittance.unsqueeze(-1)).sum({0, 1, 2})};
   InputGradients<T> dst{out.means.data_ptr<T>(), out.covariances.data_ptr<T>(), out.colors.data_ptr<T>(),
                         out.opacities.data_ptr<T>()};
   if (stats) {
     dst.mean2d_grad_norm_sum = stats->grad_norm_sum.data_ptr<T>();
     dst.visible_count = stats->visible_count.data_ptr<int32_t>();
   }
-  cpu::project_backward(in, saved.radii.data_ptr<int32_t>(), splat_ptr<T>(splat_grads), dst);
+  cpu::project_backward(in, saved.radii.data_ptr<int32_t>(), splat_ptr<T>(splat_grads),
+                        color_jacobian_ptr<T>(saved.color_jacobians), dst);
   return out;
 }
 

@@ -65,11 +65,12 @@ ForwardTensors forward_cuda(const RasterTensors& t, const CallConfig& config) {
   f.splats = at::empty({c * n, kSplatWidth}, opts);
   f.radii = at::empty({c, n}, int_opts);
   TorchWorkspace workspace(t.means.device());
+  f.color_jacobians = empty_color_jacobians(in, opts);
   at::Tensor rects = at::empty({c * n, 4}, int_opts);
   const ProjectedBuffers<float> projected{splat_ptr(f.splats), reinterpret_cast<TileRect*>(rects.data_ptr<int32_t>()),
-                                          f.radii.data_ptr<int32_t>()};
-  cuda::project(in, projected, stream);
-  const cuda::DepthOrder order = cuda::sort_by_depth(in, projected, workspace, stream);
+                                          f.radii.data_ptr<int32_t>(), color_jacobian_ptr<float>(f.color_jacobians)};
+  const cuda::DepthKeys depth_keys = cuda::project(in, projected, workspace, stream);
+  const cuda::DepthOrder order = cuda::sort_by_depth(in, projected, depth_keys, workspace, stream);
   f.ranges = at::empty({in.num_tiles(), 2}, int_opts);
   f.gaussian_ids = at::empty({order.total}, int_opts);
   cuda::bin(in, projected, order, f.gaussian_ids.data_ptr<int32_t>(), f.ranges.data_ptr<int32_t>(), workspace, stream);
@@ -95,23 +96,26 @@ InputGradTensors backward_cuda(const RasterTensors& t, const CallConfig& config,
   const RasterInputs<float> in = make_inputs<float>(t, config, camera_ptr(cameras));
   const TileBins bins{saved.ranges.data_ptr<int32_t>(), saved.gaussian_ids.data_ptr<int32_t>(),
                       saved.gaussian_ids.numel()};
-  const ImageBuffers<float> image{nullptr, nullptr, nullptr, saved.final_transmittance.data_ptr<float>(),
-                                  saved.last.data_ptr<int32_t>()};
+  const ImageBuffers<float> image{nullptr, nullptr, saved.depth.data_ptr<float>(),
+                                  saved.final_transmittance.data_ptr<float>(), saved.last.data_ptr<int32_t>()};
   at::Tensor splat_grads = at::zeros_like(saved.splats);
+  InputGradTensors out{at::empty_like(t.means), at::empty_like(t.covariances), at::empty_like(t.colors),
+                       at::empty_like(t.opacities), at::zeros_like(t.background)};
   cuda::render_backward(in, splat_ptr(saved.splats), bins, image,
                         ImageGradients<float>{grads.rgb.data_ptr<float>(), grads.alpha.data_ptr<float>(),
                                               grads.depth.defined() ? grads.depth.data_ptr<float>() : nullptr},
                         splat_ptr(splat_grads), stream);
+  cuda::background_backward(in, saved.final_transmittance.data_ptr<float>(), grads.rgb.data_ptr<float>(),
+                            out.background.data_ptr<float>(), stream);
 
-  InputGradTensors out{at::empty_like(t.means), at::empty_like(t.covariances), at::empty_like(t.colors),
-                       at::empty_like(t.opacities)};
   InputGradients<float> dst{out.means.data_ptr<float>(), out.covariances.data_ptr<float>(),
                             out.colors.data_ptr<float>(), out.opacities.data_ptr<float>()};
   if (stats) {
     dst.mean2d_grad_norm_sum = stats->grad_norm_sum.data_ptr<float>();
     dst.visible_count = stats->visible_count.data_ptr<int32_t>();
   }
-  cuda::project_backward(in, saved.radii.data_ptr<int32_t>(), splat_ptr(splat_grads), dst, stream);
+  cuda::project_backward(in, saved.radii.data_ptr<int32_t>(), splat_ptr(splat_grads),
+                         color_jacobian_ptr<float>(saved.color_jacobians), dst, stream);
   return out;
 }
 

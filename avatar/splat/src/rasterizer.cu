@@ -8,7 +8,9 @@
 
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_scan.cuh>
+#include <thrust/iterator/transform_iterator.h>
 
+#include <algorithm>
 #include <climits>
 #include <stdexcept>
 
@@ -17,11 +19,7 @@ namespace {
 
 constexpr int kThreads = 256;
 unsigned grid_for(int64_t n, int threads = kThreads) { return unsigned((n + threads - 1) / threads); }
-// project_backward_kernel needs over 100 registers a thread (the projection's
-// and the SH's derivatives): small blocks waste none of a multiprocessor's
-// register file, and nine of them (18 warps) fit its shared memory.
-constexpr int kProjectBackwardThreads = 64;
-constexpr int kProjectBackwardBlocks = 9;
+constexpr int kProjectBackwardThreads = 128;
 
 // Bits needed to hold values in [0, count).
 int bits_for(int64_t count) {
@@ -30,34 +28,33 @@ int bits_for(int64_t count) {
   return bits;
 }
 
-__global__ void project_kernel(RasterInputs<float> in, ProjectedBuffers<float> out) {
+// Also writes the depth sort's key: the camera in the high word, the depth's
+// bits (positive floats sort as integers) in the low word; culled Gaussians
+// touch no tile, their key is irrelevant.
+__global__ void project_kernel(RasterInputs<float> in, ProjectedBuffers<float> out, DepthKeys depth_keys) {
   const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
   if (i >= in.num_projected()) return;
-  const int64_t n = in.num_gaussians;
+  const int64_t n = in.num_gaussians, g = i % n;
+  const int32_t camera = int32_t(i / n);
   Splat2D<float> splat{};
   TileRect rect;
-  out.radii[i] = project_one(in, int32_t(i / n), i % n, splat, rect);
+  ColorJacobian<float> jacobian;
+  const float* sh_row = in.colors + int64_t(3) * in.sh_coefficients * g;
+  const int32_t radius = project_one(in, camera, g, sh_row, splat, rect, &jacobian);
+  out.radii[i] = radius;
   out.splats[i] = splat;
   out.rects[i] = rect;
+  if (out.color_jacobians && radius > 0) out.color_jacobians[i] = jacobian;  // the backward pass reads no other
+  depth_keys.keys[i] = (uint64_t(camera) << 32) | (radius > 0 ? __float_as_uint(splat.depth) : 0xffffffffu);
+  depth_keys.ids[i] = int32_t(i);
 }
 
-// Key: camera in the high word, depth's bits (positive floats sort as
-// integers) in the low word. Culled Gaussians touch no tile; their key is
-// irrelevant.
-__global__ void depth_keys_kernel(RasterInputs<float> in, ProjectedBuffers<float> projected, uint64_t* keys,
-                                  int32_t* ids) {
-  const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
-  if (i >= in.num_projected()) return;
-  const uint64_t camera = uint64_t(i / in.num_gaussians);
-  const uint32_t depth_bits = projected.radii[i] > 0 ? __float_as_uint(projected.splats[i].depth) : 0xffffffffu;
-  keys[i] = (camera << 32) | depth_bits;
-  ids[i] = int32_t(i);
-}
-
-__global__ void tile_counts_kernel(int64_t count, const int32_t* ids, const TileRect* rects, int64_t* counts) {
-  const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
-  if (i < count) counts[i] = rects[ids[i]].count();
-}
+// The number of tiles of a projected Gaussian's rectangle, read by the scan
+// of sort_by_depth through an iterator (no array of counts).
+struct RectTileCount {
+  const TileRect* rects;
+  __device__ int64_t operator()(int32_t id) const { return rects[id].count(); }
+};
 
 // Writes each Gaussian's slots: the key of each tile of its rectangle that
 // its ellipse may touch, or `culled` (past every tile: sorted to the end and
@@ -116,56 +113,97 @@ __global__ void __launch_bounds__(kThreads) emit_intersections_kernel(RasterInpu
   }
 }
 
-__global__ void tile_ranges_kernel(int64_t count, uint32_t culled, const uint32_t* sorted_keys, int32_t* ranges) {
-  const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
-  if (i >= count) return;
-  const uint32_t key = sorted_keys[i];
-  if (key == culled) return;
-  if (i == 0 || sorted_keys[i - 1] != key) ranges[2 * int64_t(key)] = int32_t(i);
-  if (i == count - 1 || sorted_keys[i + 1] != key) ranges[2 * int64_t(key) + 1] = int32_t(i + 1);
+// Tile t's run in the tile-sorted keys begins at the first key >= t: a
+// binary search per tile boundary (a few tens of thousands of searches)
+// rather than a pass over tens of millions of keys. Boundary num_tiles is
+// the first culled key, the end of the last tile.
+__global__ void tile_ranges_kernel(int64_t num_tiles, int64_t count, const uint32_t* sorted_keys, int32_t* ranges) {
+  const int64_t tile = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (tile > num_tiles) return;
+  int64_t low = 0, high = count;
+  while (low < high) {
+    const int64_t middle = (low + high) / 2;
+    if (sorted_keys[middle] < uint64_t(tile)) {
+      low = middle + 1;
+    } else {
+      high = middle;
+    }
+  }
+  if (tile < num_tiles) ranges[2 * tile] = int32_t(low);
+  if (tile > 0) ranges[2 * tile - 1] = int32_t(low);
 }
 
-// SH rows go through shared memory: a thread's row is 3K consecutive floats,
-// so reading and writing them in place would touch a cache line per thread
-// and value. The block moves its rows with coalesced accesses instead; rows
-// are padded to an odd stride so that the threads' accesses hit distinct banks.
-__global__ void __launch_bounds__(kProjectBackwardThreads, kProjectBackwardBlocks)
+// A thread per Gaussian. Its SH gradient row (3K consecutive floats) leaves
+// through shared memory: stored in place, each store instruction of a warp
+// would touch 32 cache lines. A warp stages its 32 rows instead and stores
+// them with coalesced accesses; rows are padded to an odd stride so that the
+// lanes' writes hit distinct banks.
+__global__ void __launch_bounds__(kProjectBackwardThreads)
     project_backward_kernel(RasterInputs<float> in, const int32_t* radii, const Splat2D<float>* splat_grads,
-                            InputGradients<float> out) {
-  extern __shared__ float sh_rows[];  // [2][blockDim.x][stride]: coefficients, then their gradients
-  const int64_t first = int64_t(blockIdx.x) * blockDim.x, g = first + threadIdx.x;
+                            const ColorJacobian<float>* color_jacobians, InputGradients<float> out) {
+  extern __shared__ float staged_rows[];  // [blockDim.x][stride]
+  const int32_t lane = int32_t(threadIdx.x % 32);
+  const int64_t g = int64_t(blockIdx.x) * blockDim.x + threadIdx.x, warp_first = g - lane;
+  if (warp_first >= in.num_gaussians) return;
   const int32_t row = 3 * in.sh_coefficients, stride = row | 1;
-  const int32_t count = int32_t(min(int64_t(blockDim.x), in.num_gaussians - first)) * row;
-  float* sh = sh_rows + threadIdx.x * stride;
-  float* grad_sh = sh + blockDim.x * stride;
-  for (int32_t e = threadIdx.x; e < count; e += blockDim.x)
-    sh_rows[e / row * stride + e % row] = in.colors[first * row + e];
+  float* warp_rows = staged_rows + (threadIdx.x - lane) * stride;
+  if (g < in.num_gaussians)
+    project_backward_one(in, radii, splat_grads, color_jacobians, g, warp_rows + lane * stride, out);
+  if (row == 0) return;
+  __syncwarp();
+  const int32_t count = int32_t(min(int64_t(32), in.num_gaussians - warp_first)) * row;
+  float* dst = out.colors + warp_first * row;
+  int32_t r = lane / row, col = lane % row;  // element e of the warp's rows is (e / row, e % row)
+  for (int32_t e = lane; e < count; e += 32) {
+    dst[e] = warp_rows[r * stride + col];
+    for (col += 32; col >= row; col -= row) ++r;
+  }
+}
+
+// A grid-stride sum: per thread, then per warp and block, then one atomic
+// per block and channel.
+__global__ void __launch_bounds__(kThreads) background_backward_kernel(int64_t pixels, const float* final_transmittance,
+                                                                       const float* grad_rgb, float* grad_background) {
+  float sum[3] = {0.0f, 0.0f, 0.0f};
+  for (int64_t p = int64_t(blockIdx.x) * blockDim.x + threadIdx.x; p < pixels; p += int64_t(gridDim.x) * blockDim.x) {
+    const float t = final_transmittance[p];
+    for (int ch = 0; ch < 3; ++ch) sum[ch] = fmaf(t, grad_rgb[3 * p + ch], sum[ch]);
+  }
+  __shared__ float warp_sums[kThreads / 32][3];
+  const unsigned lane = threadIdx.x % 32, warp = threadIdx.x / 32;
+  for (int ch = 0; ch < 3; ++ch) {
+    for (int offset = 16; offset > 0; offset /= 2) sum[ch] += __shfl_xor_sync(0xffffffffu, sum[ch], offset);
+    if (lane == 0) warp_sums[warp][ch] = sum[ch];
+  }
   __syncthreads();
-  if (g < in.num_gaussians) project_backward_one(in, radii, splat_grads, g, sh, grad_sh, out);
-  __syncthreads();
-  for (int32_t e = threadIdx.x; e < count; e += blockDim.x)
-    out.colors[first * row + e] = sh_rows[(blockDim.x + e / row) * stride + e % row];
+  if (threadIdx.x < 3) {
+    float total = 0.0f;
+    for (int w = 0; w < kThreads / 32; ++w) total += warp_sums[w][threadIdx.x];
+    atomicAdd(grad_background + threadIdx.x, total);
+  }
 }
 
 }  // namespace
 
-void project(const RasterInputs<float>& in, const ProjectedBuffers<float>& out, cudaStream_t stream) {
-  if (in.num_projected() == 0) return;
-  project_kernel<<<grid_for(in.num_projected()), kThreads, 0, stream>>>(in, out);
+DepthKeys project(const RasterInputs<float>& in, const ProjectedBuffers<float>& out, Workspace& workspace,
+                  cudaStream_t stream) {
+  const int64_t count = in.num_projected();
+  if (count == 0) return {};
+  if (count > INT_MAX) throw std::runtime_error("tega splat: more than 2^31 projected Gaussians");
+  const DepthKeys keys{static_cast<uint64_t*>(workspace.allocate(2 * count * sizeof(uint64_t))),
+                       static_cast<int32_t*>(workspace.allocate(2 * count * sizeof(int32_t)))};
+  project_kernel<<<grid_for(count), kThreads, 0, stream>>>(in, out, keys);
   TEGA_CHECK_LAUNCH(project_kernel);
+  return keys;
 }
 
 DepthOrder sort_by_depth(const RasterInputs<float>& in, const ProjectedBuffers<float>& projected,
-                         Workspace& workspace, cudaStream_t stream) {
+                         const DepthKeys& depth_keys, Workspace& workspace, cudaStream_t stream) {
   DepthOrder order;
   const int64_t count = in.num_projected();
   if (count == 0) return order;
-  if (count > INT_MAX) throw std::runtime_error("tega splat: more than 2^31 projected Gaussians");
-  auto* keys = static_cast<uint64_t*>(workspace.allocate(2 * count * sizeof(uint64_t)));
-  auto* ids = static_cast<int32_t*>(workspace.allocate(2 * count * sizeof(int32_t)));
-  depth_keys_kernel<<<grid_for(count), kThreads, 0, stream>>>(in, projected, keys, ids);
-  TEGA_CHECK_LAUNCH(depth_keys_kernel);
-
+  uint64_t* keys = depth_keys.keys;
+  int32_t* ids = depth_keys.ids;
   const int end_bit = 32 + bits_for(in.num_cameras);
   std::size_t sort_bytes = 0;
   TEGA_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, sort_bytes, keys, keys + count, ids, ids + count,
@@ -175,10 +213,8 @@ DepthOrder sort_by_depth(const RasterInputs<float>& in, const ProjectedBuffers<f
                                                   int(count), 0, end_bit, stream));
   const int32_t* sorted_ids = ids + count;
 
-  auto* counts = static_cast<int64_t*>(workspace.allocate(2 * count * sizeof(int64_t)));
-  tile_counts_kernel<<<grid_for(count), kThreads, 0, stream>>>(count, sorted_ids, projected.rects, counts);
-  TEGA_CHECK_LAUNCH(tile_counts_kernel);
-  int64_t* offsets = counts + count;
+  const auto counts = thrust::make_transform_iterator(sorted_ids, RectTileCount{projected.rects});
+  auto* offsets = static_cast<int64_t*>(workspace.allocate(count * sizeof(int64_t)));
   std::size_t scan_bytes = 0;
   TEGA_CUDA_CHECK(cub::DeviceScan::InclusiveSum(nullptr, scan_bytes, counts, offsets, int(count), stream));
   void* scan_temp = workspace.allocate(scan_bytes);
@@ -194,9 +230,11 @@ DepthOrder sort_by_depth(const RasterInputs<float>& in, const ProjectedBuffers<f
 void bin(const RasterInputs<float>& in, const ProjectedBuffers<float>& projected, const DepthOrder& order,
          int32_t* gaussian_ids, int32_t* ranges, Workspace& workspace, cudaStream_t stream) {
   const int64_t num_tiles = in.num_tiles();
-  TEGA_CUDA_CHECK(cudaMemsetAsync(ranges, 0, 2 * num_tiles * sizeof(int32_t), stream));
   const int64_t total = order.total;
-  if (total == 0) return;
+  if (total == 0) {
+    TEGA_CUDA_CHECK(cudaMemsetAsync(ranges, 0, 2 * num_tiles * sizeof(int32_t), stream));
+    return;
+  }
   if (total > INT_MAX) throw std::runtime_error("tega splat: more than 2^31 tile-Gaussian intersections");
   auto* keys = static_cast<uint32_t*>(workspace.allocate(2 * total * sizeof(uint32_t)));
   auto* unsorted_ids = static_cast<int32_t*>(workspace.allocate(total * sizeof(int32_t)));
@@ -214,18 +252,29 @@ void bin(const RasterInputs<float>& in, const ProjectedBuffers<float>& projected
   void* sort_temp = workspace.allocate(sort_bytes);
   TEGA_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(sort_temp, sort_bytes, keys, keys + total, unsorted_ids,
                                                   gaussian_ids, int(total), 0, end_bit, stream));
-  tile_ranges_kernel<<<grid_for(total), kThreads, 0, stream>>>(total, uint32_t(num_tiles), keys + total, ranges);
+  tile_ranges_kernel<<<grid_for(num_tiles + 1), kThreads, 0, stream>>>(num_tiles, total, keys + total, ranges);
   TEGA_CHECK_LAUNCH(tile_ranges_kernel);
 }
 
 void project_backward(const RasterInputs<float>& in, const int32_t* radii, const Splat2D<float>* splat_grads,
-                      const InputGradients<float>& out, cudaStream_t stream) {
+                      const ColorJacobian<float>* color_jacobians, const InputGradients<float>& out,
+                      cudaStream_t stream) {
   if (in.num_gaussians == 0) return;
   const int32_t sh_stride = in.sh_coefficients > 0 ? (3 * in.sh_coefficients) | 1 : 0;
-  const std::size_t shared_bytes = 2 * kProjectBackwardThreads * sh_stride * sizeof(float);
+  const std::size_t shared_bytes = kProjectBackwardThreads * sh_stride * sizeof(float);
   project_backward_kernel<<<grid_for(in.num_gaussians, kProjectBackwardThreads), kProjectBackwardThreads,
-                            shared_bytes, stream>>>(in, radii, splat_grads, out);
+                            shared_bytes, stream>>>(in, radii, splat_grads, color_jacobians, out);
   TEGA_CHECK_LAUNCH(project_backward_kernel);
+}
+
+void background_backward(const RasterInputs<float>& in, const float* final_transmittance, const float* grad_rgb,
+                         float* grad_background, cudaStream_t stream) {
+  const int64_t pixels = in.num_pixels();
+  if (pixels == 0) return;
+  constexpr unsigned kMaxBlocks = 1024;  // a few per multiprocessor; each then adds many pixels
+  background_backward_kernel<<<std::min(grid_for(pixels), kMaxBlocks), kThreads, 0, stream>>>(
+      pixels, final_transmittance, grad_rgb, grad_background);
+  TEGA_CHECK_LAUNCH(background_backward_kernel);
 }
 
 }  // namespace tega::splat::cuda

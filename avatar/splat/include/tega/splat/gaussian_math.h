@@ -20,6 +20,7 @@ inline constexpr double kLowPassVariance = 0.3;        // px², added to the 2D 
 inline constexpr double kMinAlpha = 1.0 / 255.0;       // smaller alphas are skipped
 inline constexpr double kMaxAlpha = 0.99;              // alpha is clamped here
 inline constexpr double kMinTransmittance = 1e-4;      // blending stops below this
+inline constexpr double kMinDepthAlpha = 1e-10;        // the expected depth is 0 at smaller alphas
 inline constexpr double kFrustumMargin = 0.15;         // J clamp: fraction of the image size
 inline constexpr int kMaxShCoefficients = 16;          // degree 3
 
@@ -228,46 +229,67 @@ TEGA_HD void sh_to_rgb(int degree, const T* sh, const T* direction, T* rgb) {
   for (int ch = 0; ch < 3; ++ch) rgb[ch] = math_max(sum[ch], T(0));
 }
 
-// Backward of sh_to_rgb for `coefficients` stored SH coefficients: writes
-// (or, with accumulate, adds) d loss / d sh to grad_sh and returns d loss /
-// d direction in grad_direction. Channels clamped at 0 pass nothing.
+// What the backward pass of sh_to_rgb needs besides the direction, kept by
+// the forward pass so that the backward pass does not read the coefficients
+// again (at 4M Gaussians they are 768 MB). Row ch holds d rgb_ch / d
+// direction (x, y, z), then 1 when the clamp at 0 passed the channel (rgb_ch
+// > 0, as ReLU decides in torch) and 0 otherwise.
 template <typename T>
-TEGA_HD void sh_to_rgb_backward(int degree, int coefficients, const T* sh, const T* direction, const T* grad_rgb,
-                                bool accumulate, T* grad_sh, T* grad_direction) {
-  const T dir2 = direction[0] * direction[0] + direction[1] * direction[1] + direction[2] * direction[2];
-  const T norm = math_sqrt(dir2);
-  grad_direction[0] = grad_direction[1] = grad_direction[2] = T(0);
-  if (!(norm > T(0))) {  // the camera sits on the mean: no colour gradient
-    if (!accumulate)
-      for (int k = 0; k < 3 * coefficients; ++k) grad_sh[k] = T(0);
-    return;
-  }
-  const T inv = T(1) / norm;
+struct alignas(4 * sizeof(T)) ColorJacobian {
+  T rows[3][4];
+};
+
+// sh_to_rgb, and the Jacobian its backward pass uses. The basis is evaluated
+// once, with its derivatives (Dual3).
+template <typename T>
+TEGA_HD void sh_to_rgb(int degree, const T* sh, const T* direction, T* rgb, ColorJacobian<T>& jacobian) {
+  const T norm = math_sqrt(direction[0] * direction[0] + direction[1] * direction[1] +
+                           direction[2] * direction[2]);
+  const T inv = norm > T(0) ? T(1) / norm : T(0);  // the camera on the mean: no direction gradient
   const T unit[3] = {direction[0] * inv, direction[1] * inv, direction[2] * inv};
-  // Which channels the clamp passes needs the whole sum, so the basis is
-  // evaluated twice: plainly for the sum, then with its derivatives.
   T sum[3] = {T(0.5), T(0.5), T(0.5)};
-  visit_sh_basis<T, T>(degree, unit[0], unit[1], unit[2], [&](int b, T value) {
-    for (int ch = 0; ch < 3; ++ch) sum[ch] += value * sh[3 * b + ch];
-  });
-  T grad_pass[3];
-  for (int ch = 0; ch < 3; ++ch) grad_pass[ch] = sum[ch] < T(0) ? T(0) : grad_rgb[ch];
-  T grad_unit[3] = {T(0), T(0), T(0)};
+  T grad_unit[3][3] = {};  // [channel][axis]
   const Dual3<T> x{unit[0], {T(1), T(0), T(0)}}, y{unit[1], {T(0), T(1), T(0)}}, z{unit[2], {T(0), T(0), T(1)}};
   visit_sh_basis<T, Dual3<T>>(degree, x, y, z, [&](int b, const Dual3<T>& value) {
-    if (b >= coefficients) return;
     for (int ch = 0; ch < 3; ++ch) {
-      const T g = value.v * grad_pass[ch];
+      const T coefficient = sh[3 * b + ch];
+      sum[ch] += value.v * coefficient;
+      for (int k = 0; k < 3; ++k) grad_unit[ch][k] += value.d[k] * coefficient;
+    }
+  });
+  // d unit / d direction = (I - unit unitᵀ) / norm
+  for (int ch = 0; ch < 3; ++ch) {
+    rgb[ch] = math_max(sum[ch], T(0));
+    const T* g = grad_unit[ch];
+    const T along = g[0] * unit[0] + g[1] * unit[1] + g[2] * unit[2];
+    T* row = jacobian.rows[ch];
+    for (int k = 0; k < 3; ++k) row[k] = (g[k] - along * unit[k]) * inv;
+    row[3] = rgb[ch] > T(0) ? T(1) : T(0);
+  }
+}
+
+// Backward of sh_to_rgb for `coefficients` stored SH coefficients, from the
+// forward pass's Jacobian: writes (or, with accumulate, adds) d loss / d sh
+// to grad_sh and adds d loss / d direction to grad_direction. Channels
+// clamped at 0 pass nothing.
+template <typename T>
+TEGA_HD void sh_to_rgb_backward(int degree, int coefficients, const ColorJacobian<T>& jacobian, const T* direction,
+                                const T* grad_rgb, bool accumulate, T* grad_sh, T* grad_direction) {
+  T grad_pass[3];
+  for (int ch = 0; ch < 3; ++ch) grad_pass[ch] = grad_rgb[ch] * jacobian.rows[ch][3];
+  for (int k = 0; k < 3; ++k)
+    for (int ch = 0; ch < 3; ++ch) grad_direction[k] += grad_pass[ch] * jacobian.rows[ch][k];
+  const T norm = math_sqrt(direction[0] * direction[0] + direction[1] * direction[1] +
+                           direction[2] * direction[2]);
+  const T inv = norm > T(0) ? T(1) / norm : T(0);
+  visit_sh_basis<T, T>(degree, direction[0] * inv, direction[1] * inv, direction[2] * inv, [&](int b, T value) {
+    for (int ch = 0; ch < 3; ++ch) {
+      const T g = value * grad_pass[ch];
       grad_sh[3 * b + ch] = accumulate ? grad_sh[3 * b + ch] + g : g;
     }
-    const T weight = grad_pass[0] * sh[3 * b] + grad_pass[1] * sh[3 * b + 1] + grad_pass[2] * sh[3 * b + 2];
-    for (int k = 0; k < 3; ++k) grad_unit[k] += weight * value.d[k];
   });
   if (!accumulate)  // stored coefficients of higher degrees than evaluated
     for (int k = 3 * (degree + 1) * (degree + 1); k < 3 * coefficients; ++k) grad_sh[k] = T(0);
-  // d unit / d direction = (I - unit unitᵀ) / norm
-  const T along = grad_unit[0] * unit[0] + grad_unit[1] * unit[1] + grad_unit[2] * unit[2];
-  for (int k = 0; k < 3; ++k) grad_direction[k] = (grad_unit[k] - along * unit[k]) * inv;
 }
 
 // ---------------------------------------------------------------------------
@@ -560,6 +582,23 @@ TEGA_HD void blend_forward(PixelAccumulator<T>& acc, const Splat2D<T>& sp, T px,
   acc.depth += w * sp.depth;
   acc.transmittance = next;
   acc.last = index + 1;
+}
+
+// The expected depth Σ w z / alpha of a pixel, 0 where alpha is too small
+// to divide by.
+template <typename T>
+TEGA_HD T expected_depth(T weighted_depth, T alpha) {
+  return alpha > T(kMinDepthAlpha) ? weighted_depth / alpha : T(0);
+}
+
+// Backward of expected_depth: from d loss / d depth, returns d loss / d Σ w z
+// and adds d loss / d alpha to grad_alpha.
+template <typename T>
+TEGA_HD T expected_depth_backward(T grad_depth, T depth, T alpha, T& grad_alpha) {
+  if (!(alpha > T(kMinDepthAlpha))) return T(0);
+  const T inv_alpha = T(1) / alpha;
+  grad_alpha -= grad_depth * depth * inv_alpha;
+  return grad_depth * inv_alpha;
 }
 
 // Per-pixel state of the backward pass, walking the blended splats back to
