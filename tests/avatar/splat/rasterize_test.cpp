@@ -94,6 +94,7 @@ TEST(Rasterize, EmptyImageShowsTheBackground) {
   Scene scene = random_scene(s);  // its only Gaussian sits behind camera 0
   const RasterOutput out = scene.render();
   EXPECT_EQ(out.alpha.abs().max().item<double>(), 0.0);
+  EXPECT_EQ(out.depth.abs().max().item<double>(), 0.0);  // no weight to divide the depth by
   EXPECT_TRUE(at::allclose(out.rgb, scene.background.view({1, 1, 1, 3}).expand_as(out.rgb)));
 }
 
