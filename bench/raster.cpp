@@ -21,9 +21,8 @@
 #include <ATen/record_function.h>
 #include <c10/cuda/CUDACachingAllocator.h>
 #include <cuda_runtime_api.h>
-#include <torch/csrc/autograd/profiler_kineto.h>
 
-#include <set>
+#include "kineto_trace.h"
 
 namespace {
 
@@ -164,14 +163,9 @@ int trace(int64_t n, int width, int height, const std::string& path) {
     cudaDeviceSynchronize();  // as the timed runs: each pass starts on an idle GPU
   };
   for (int i = 0; i < kWarmups; ++i) step();
-  namespace profiler = torch::autograd::profiler;
-  using torch::profiler::impl::ActivityType;
-  const torch::profiler::impl::ProfilerConfig config(torch::profiler::impl::ProfilerState::KINETO);
-  const std::set<ActivityType> activities{ActivityType::CPU, ActivityType::CUDA};
-  profiler::prepareProfiler(config, activities);
-  profiler::enableProfiler(config, activities);
-  for (int i = 0; i < 3; ++i) step();
-  profiler::disableProfiler()->save(path);
+  tega::bench::kineto_trace(path, [&] {
+    for (int i = 0; i < 3; ++i) step();
+  });
   return 0;
 }
 

@@ -29,7 +29,8 @@
 
 #ifdef TEGA_TORCH_HAS_CUDA
 #include <c10/cuda/CUDACachingAllocator.h>
-#include <torch/csrc/autograd/profiler_kineto.h>
+
+#include "kineto_trace.h"
 #endif
 
 namespace {
@@ -38,14 +39,7 @@ namespace {
 template <class Work>
 void trace_to(const std::string& path, Work&& work) {
 #ifdef TEGA_TORCH_HAS_CUDA
-  namespace profiler = torch::autograd::profiler;
-  using torch::profiler::impl::ActivityType;
-  const torch::profiler::impl::ProfilerConfig config(torch::profiler::impl::ProfilerState::KINETO);
-  const std::set<ActivityType> activities{ActivityType::CPU, ActivityType::CUDA};
-  profiler::prepareProfiler(config, activities);
-  profiler::enableProfiler(config, activities);
-  work();
-  profiler::disableProfiler()->save(path);
+  tega::bench::kineto_trace(path, work);
 #else
   (void)work;
   throw tega::Error("--trace " + path + ": this build has no CUDA profiler");
