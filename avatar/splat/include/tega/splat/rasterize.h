@@ -42,7 +42,7 @@ struct MeanGradientStats {
 struct RasterOutput {
   at::Tensor rgb;      // [C, H, W, 3], background blended in
   at::Tensor alpha;    // [C, H, W], accumulated opacity
-  at::Tensor depth;    // [C, H, W], expected camera z: Σ wᵢ zᵢ / alpha (0 where alpha = 0)
+  at::Tensor depth;    // [C, H, W], expected camera z: Σ wᵢ zᵢ / alpha (0 where alpha ≤ 1e-10)
   at::Tensor radii;    // [C, N] int32, screen-space radius in pixels, 0 when culled
   at::Tensor visible;  // [C, N] bool, radii > 0
 };
