@@ -138,4 +138,14 @@ void write_png_with_libpng(const Image16& image, const fs::path& file) {
   write_file_atomic(file, [&](const fs::path& temp) { detail::write_png(image, temp, file); });
 }
 
+void write_png_view(const PixelView& view, const fs::path& file, int compression) {
+  if (!view.data || view.width <= 0 || view.height <= 0 || view.channels < 1 || view.channels > 4 ||
+      (view.bit_depth != 8 && view.bit_depth != 16) ||
+      view.row_bytes < size_t(view.width) * view.channels * (view.bit_depth / 8) || compression < 0 ||
+      compression > 9) {
+    throw Error(file, "invalid pixel view or compression level for PNG");
+  }
+  write_file_atomic(file, [&](const fs::path& temp) { detail::write_png_rows(view, temp, file, compression); });
+}
+
 }  // namespace tega

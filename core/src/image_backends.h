@@ -16,6 +16,8 @@ using StoredImage = std::variant<Image8, Image16, ImageF>;
 StoredImage read_png(const std::filesystem::path& file);
 // Image8 or Image16 only.
 void write_png(const StoredImage& image, const std::filesystem::path& target, const std::filesystem::path& file);
+void write_png_rows(const PixelView& view, const std::filesystem::path& target, const std::filesystem::path& file,
+                    int compression);
 
 #ifdef TEGA_HAVE_OPENIMAGEIO
 StoredImage read_oiio(const std::filesystem::path& file);

@@ -3,6 +3,8 @@
 #include <png.h>
 
 #include <bit>
+#include <cerrno>
+#include <cstring>
 #include <csetjmp>
 #include <cstdio>
 #include <memory>
@@ -72,8 +74,11 @@ bool decode_rows(png_structp png, png_bytepp rows) {
   return true;
 }
 
-bool encode(png_structp png, png_infop info, FILE* fp, const Layout* layout, png_bytepp rows) {
+bool encode(png_structp png, png_infop info, FILE* fp, const Layout* layout, png_bytepp rows, int compression) {
   if (setjmp(png_jmpbuf(png))) return false;
+  png_set_compression_level(png, compression);
+  // At the fastest levels adaptive filtering costs more time than it saves bytes.
+  if (compression == 0 || compression == 1) png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
   static constexpr int kColourTypes[] = {PNG_COLOR_TYPE_GRAY, PNG_COLOR_TYPE_GRAY_ALPHA, PNG_COLOR_TYPE_RGB,
                                          PNG_COLOR_TYPE_RGB_ALPHA};
   png_init_io(png, fp);
@@ -86,7 +91,6 @@ bool encode(png_structp png, png_infop info, FILE* fp, const Layout* layout, png
   return true;
 }
 
-// libpng takes non-const row pointers even when it only reads through them (writing).
 template <typename T>
 std::vector<png_bytep> row_pointers(const ImageBuffer<T>& image) {
   std::vector<png_bytep> rows(image.height);
@@ -145,32 +149,37 @@ StoredImage read_png(const fs::path& file) {
 }
 
 void write_png(const StoredImage& image, const fs::path& target, const fs::path& file) {
-  Layout layout;
-  std::vector<png_bytep> rows;
-  const auto describe = [&](const auto& buffer, int bit_depth) {
-    layout = {static_cast<png_uint_32>(buffer.width), static_cast<png_uint_32>(buffer.height), buffer.channels,
-              bit_depth};
-    rows = row_pointers(buffer);
-  };
   if (const auto* u8 = std::get_if<Image8>(&image)) {
-    describe(*u8, 8);
+    write_png_rows({u8->pixels.data(), u8->width, u8->height, u8->channels, 8, size_t(u8->width) * u8->channels},
+                   target, file, PNG_Z_DEFAULT_COMPRESSION);
   } else if (const auto* u16 = std::get_if<Image16>(&image)) {
-    describe(*u16, 16);
+    write_png_rows({u16->pixels.data(), u16->width, u16->height, u16->channels, 16,
+                    size_t(u16->width) * u16->channels * 2},
+                   target, file, PNG_Z_DEFAULT_COMPRESSION);
   } else {
     throw Error(file, "PNG cannot store float pixels (write 8 or 16 bits)");
   }
+}
+
+void write_png_rows(const PixelView& view, const fs::path& target, const fs::path& file, int compression) {
+  const Layout layout{static_cast<png_uint_32>(view.width), static_cast<png_uint_32>(view.height), view.channels,
+                      view.bit_depth};
+  // libpng takes non-const row pointers even when it only reads through them (writing).
+  std::vector<png_bytep> rows(view.height);
+  auto* first = static_cast<png_bytep>(const_cast<void*>(view.data));
+  for (int y = 0; y < view.height; ++y) rows[y] = first + y * view.row_bytes;
 
   FilePtr fp(std::fopen(target.c_str(), "wb"));
-  if (!fp) throw Error(file, "cannot be written");
+  if (!fp) throw Error(file, std::string("cannot be written (") + std::strerror(errno) + ")");
   PngMessage message;
   WriteStructs structs;
   structs.png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &message, on_error, on_warning);
   if (structs.png) structs.info = png_create_info_struct(structs.png);
   if (!structs.info) throw Error(file, "libpng could not start");
-  if (!encode(structs.png, structs.info, fp.get(), &layout, rows.data())) {
+  if (!encode(structs.png, structs.info, fp.get(), &layout, rows.data(), compression)) {
     throw Error(file, std::string("could not be written as PNG (") + message.text + ")");
   }
-  if (std::fclose(fp.release()) != 0) throw Error(file, "could not be written");
+  if (std::fclose(fp.release()) != 0) throw Error(file, std::string("could not be written (") + std::strerror(errno) + ")");
 }
 
 }  // namespace tega::detail

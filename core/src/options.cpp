@@ -40,6 +40,21 @@ void assign(OptionField& field, const YAML::Node& value, const std::string& key,
         if constexpr (std::is_same_v<T, OptionField::Nested>) {
           if (!value.IsMap()) throw Error(source, "option '" + key + "'" + location(value) + " must be a mapping");
           apply_node(target, value, key + ".", source);
+        } else if constexpr (std::is_same_v<T, OptionField::List>) {
+          if (!value.IsSequence() && !value.IsNull()) {
+            throw Error(source, "option '" + key + "'" + location(value) + " must be a list of mappings");
+          }
+          target.resize(0);  // elements the YAML lists start from their defaults, not the old list's
+          target.resize(value.IsNull() ? 0 : value.size());
+          for (size_t i = 0; i < target.size(); ++i) {
+            const std::string element_key = key + "[" + std::to_string(i) + "]";
+            if (!value[i].IsMap() && !value[i].IsNull()) {
+              throw Error(source, "option '" + element_key + "'" + location(value[i]) + " must be a mapping");
+            }
+            if (value[i].IsNull()) continue;
+            OptionField::Nested element = target.element(i);
+            apply_node(element, value[i], element_key + ".", source);
+          }
         } else if constexpr (std::is_same_v<T, bool*>) {
           *target = convert<bool>(value, source, key, "true or false");
         } else if constexpr (std::is_same_v<T, int*>) {
@@ -94,7 +109,7 @@ void write_value(std::ostringstream& out, const OptionField::Target& target) {
         using T = std::decay_t<decltype(value)>;
         if constexpr (std::is_same_v<T, std::string*>) {
           e << YAML::DoubleQuoted << *value;
-        } else if constexpr (!std::is_same_v<T, OptionField::Nested>) {
+        } else if constexpr (!std::is_same_v<T, OptionField::Nested> && !std::is_same_v<T, OptionField::List>) {
           e << *value;
         }
       },
@@ -110,6 +125,16 @@ void write_fields(std::ostringstream& out, const std::vector<OptionField>& field
     if (const auto* nested = std::get_if<OptionField::Nested>(&f.target)) {
       out << pad << f.key << ":\n";
       write_fields(out, *nested, indent + 2);
+    } else if (const auto* list = std::get_if<OptionField::List>(&f.target)) {
+      if (list->size() == 0) {
+        out << pad << f.key << ": []\n";
+        continue;
+      }
+      out << pad << f.key << ":\n";
+      for (size_t i = 0; i < list->size(); ++i) {
+        out << pad << "  -\n";
+        write_fields(out, list->element(i), indent + 4);
+      }
     } else {
       out << pad << f.key << ": ";
       write_value(out, f.target);

@@ -104,6 +104,58 @@ TEST(Options, PrintedYamlDocumentsEveryFieldAndLoadsBack) {
   EXPECT_EQ(back.background, o.background);
 }
 
+struct ShotOptions {
+  std::string camera = "cam00";
+  int frames = 1;
+  template <class V>
+  void visit(V& v) {
+    v("camera", camera, "Camera name.");
+    v("frames", frames, "Frames to take.");
+  }
+};
+
+struct PlanOptions {
+  std::vector<ShotOptions> shots{ShotOptions{}};
+  template <class V>
+  void visit(V& v) {
+    v("shots", shots, "Shots, in order.");
+  }
+};
+
+TEST(Options, ListOfMappingsReplacesTheDefaultAndKeepsElementDefaults) {
+  PlanOptions o;
+  tega::load_options_from_string(o, "shots:\n  - {camera: a, frames: 3}\n  - {camera: b}\n", "", "plan.yaml");
+  ASSERT_EQ(o.shots.size(), 2u);
+  EXPECT_EQ(o.shots[0].camera, "a");
+  EXPECT_EQ(o.shots[0].frames, 3);
+  EXPECT_EQ(o.shots[1].camera, "b");
+  EXPECT_EQ(o.shots[1].frames, 1);
+
+  const auto unknown = error_of([&] { tega::load_options_from_string(o, "shots: [{cam: a}]\n", "", "plan.yaml"); });
+  EXPECT_NE(unknown.find("'shots[0].cam'"), std::string::npos) << unknown;
+  const auto not_a_list = error_of([&] { tega::load_options_from_string(o, "shots: 3\n", "", "plan.yaml"); });
+  EXPECT_NE(not_a_list.find("must be a list of mappings"), std::string::npos) << not_a_list;
+}
+
+TEST(Options, PrintedListLoadsBack) {
+  PlanOptions o;
+  o.shots = {{"left", 2}, {"right", 5}};
+  const std::string yaml = tega::options_to_yaml(o);
+  EXPECT_NE(yaml.find("# Frames to take."), std::string::npos) << yaml;
+  PlanOptions back;
+  back.shots.clear();
+  tega::load_options_from_string(back, yaml, "", "printed");
+  ASSERT_EQ(back.shots.size(), 2u);
+  EXPECT_EQ(back.shots[1].camera, "right");
+  EXPECT_EQ(back.shots[1].frames, 5);
+
+  PlanOptions empty;
+  empty.shots.clear();
+  PlanOptions empty_back;
+  tega::load_options_from_string(empty_back, tega::options_to_yaml(empty), "", "printed");
+  EXPECT_TRUE(empty_back.shots.empty());
+}
+
 TEST(Options, MissingFileIsNamed) {
   ExampleOptions o;
   const auto message = error_of([&] { tega::load_options(o, "/nonexistent/dir/x.yaml"); });

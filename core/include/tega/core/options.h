@@ -7,12 +7,15 @@
 //     template <class V> void visit(V& v) { v("cameras", cameras, "Number of cameras."); }
 //   };
 //
-// A field may itself be a struct with visit() (a nested YAML mapping).
+// A field may itself be a struct with visit() (a nested YAML mapping), or a
+// std::vector of such structs (a YAML sequence of mappings, e.g. a rig's
+// cameras); a list given in YAML replaces the default list whole.
 // Loading is strict: a key that is not a field is an error naming the file,
 // the key and the known keys; so is a value of the wrong type.
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <type_traits>
 #include <variant>
@@ -24,21 +27,45 @@ namespace tega {
 
 struct OptionField {
   using Nested = std::vector<OptionField>;
+  // A std::vector of option structs, reached through the vector it belongs to.
+  struct List {
+    std::function<size_t()> size;
+    std::function<void(size_t)> resize;
+    std::function<Nested(size_t)> element;  // the fields of element i
+  };
   using Target = std::variant<bool*, int*, int64_t*, float*, double*, std::string*, std::vector<int>*,
-                              std::vector<double>*, std::vector<std::string>*, Nested>;
+                              std::vector<double>*, std::vector<std::string>*, Nested, List>;
   std::string key;
   std::string doc;
   Target target;
 };
 
+class OptionCollector;
+
+template <class T>
+concept OptionStruct = requires(T& value, OptionCollector& collector) { value.visit(collector); };
+
+template <class T>
+struct is_option_struct_list : std::false_type {};
+template <OptionStruct T>
+struct is_option_struct_list<std::vector<T>> : std::true_type {};
+
 class OptionCollector {
  public:
   template <class T>
   void operator()(const char* key, T& value, const char* doc) {
-    if constexpr (requires { value.visit(*this); }) {
+    if constexpr (OptionStruct<T>) {
       OptionCollector nested;
       value.visit(nested);
       fields.push_back({key, doc, std::move(nested.fields)});
+    } else if constexpr (is_option_struct_list<T>::value) {
+      OptionField::List list{[&value] { return value.size(); }, [&value](size_t n) { value.resize(n); },
+                             [&value](size_t i) {
+                               OptionCollector element;
+                               value[i].visit(element);
+                               return std::move(element.fields);
+                             }};
+      fields.push_back({key, doc, std::move(list)});
     } else {
       fields.push_back({key, doc, &value});
     }
