@@ -3,7 +3,7 @@
 #include <cstdio>
 
 #include "studio.h"
-#include "tega/core/files.h"
+#include "tega/core/take.h"
 #include "tega/synth/random.h"
 
 namespace tega::synth {
@@ -65,13 +65,13 @@ std::string frame_name(int frame) {
 }
 
 void write_take_json(const Studio& studio, const std::string& take, const std::string& kind, int frames) {
-  const nlohmann::json j = {{"name", take},
-                            {"kind", kind},
-                            {"cameras", studio.rig.camera_names()},
-                            {"frames", frames},
-                            {"fps", studio.options.fps},
-                            {"images", "{camera}/{frame:06d}.png"}};
-  write_text_atomic(studio.root / "takes" / take / "take.json", j.dump(2) + "\n");
+  TakeInfo info;  // the defaults describe capture_image(): 8-bit RGB PNGs
+  info.name = take;
+  info.kind = kind;
+  info.cameras = studio.rig.camera_names();
+  info.frames = frames;
+  info.fps = studio.options.fps;
+  write_take(info, studio.root / "takes" / take);
 }
 
 }  // namespace tega::synth

@@ -14,6 +14,7 @@
 #include "tega/core/mesh.h"
 #include "tega/core/rig.h"
 #include "tega/core/files.h"
+#include "tega/core/take.h"
 #include "tega/synth/virtual_studio.h"
 #include "test_support.h"
 
@@ -181,6 +182,7 @@ TEST(Capture, DatasetValidatesWithHeldOutTakeAndCamera) {
 
 TEST(Capture, WritesTheTakesItDescribes) {
   const fs::path root = capture();
+  EXPECT_NO_THROW(tega::validate_capture(root));
   const nlohmann::json c = read_json(root / "capture.json");
   EXPECT_EQ(c["cameras"].size(), 3u);
   for (const auto& take : c["takes"]) {
