@@ -102,6 +102,24 @@ TEST(ImagePng, FloatPixelsAreClampedAndRounded) {
   EXPECT_FALSE(std::filesystem::exists(dir / "float.png"));
 }
 
+TEST(ImagePng, PixelViewWithRowPaddingIsWrittenExactlyAtEveryLevel) {
+  test::TempDir dir;
+  const int width = 5, height = 3, row_bytes = 16;  // rows padded past width * 2 bytes
+  std::vector<uint16_t> padded(row_bytes / 2 * height, 0xFFFF);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) padded[y * row_bytes / 2 + x] = uint16_t(1000 * y + 37 * x);
+  for (int level : {0, 1, 9}) {
+    const auto file = dir / ("view" + std::to_string(level) + ".png");
+    write_png_view({padded.data(), width, height, 1, 16, size_t(row_bytes)}, file, level);
+    const ImageF back = read_png_with_libpng(file);
+    ASSERT_EQ(back.width, width);
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x) EXPECT_EQ(std::lround(back.at(x, y, 0) * 65535), 1000 * y + 37 * x);
+  }
+  EXPECT_THROW(write_png_view({padded.data(), width, height, 1, 16, 4}, dir / "short_rows.png", 1), Error);
+  EXPECT_FALSE(std::filesystem::exists(dir / "short_rows.png"));
+}
+
 TEST(ImageErrors, NonImageAndMissingFilesAreNamed) {
   test::TempDir dir;
   const auto text = dir / "notes.png";
