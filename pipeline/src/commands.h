@@ -9,6 +9,7 @@ void add_synth_command(CLI::App& app);
 void add_dataset_command(CLI::App& app);
 void add_rig_command(CLI::App& app);
 void add_ingest_command(CLI::App& app);
+void add_capture_command(CLI::App& app);
 void add_train_command(CLI::App& app);
 void add_render_command(CLI::App& app);
 void add_eval_command(CLI::App& app);
