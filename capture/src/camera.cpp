@@ -2,6 +2,7 @@
 
 #include <arv.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <sstream>
@@ -65,6 +66,19 @@ std::vector<CameraDescription> list_cameras() {
   return cameras;
 }
 
+std::vector<CameraDescription> discover_cameras(const std::vector<std::string>& serials) {
+  constexpr int kAttempts = 3;
+  std::vector<CameraDescription> cameras;
+  for (int attempt = 0; attempt < kAttempts; ++attempt) {
+    cameras = list_cameras();
+    bool all = true;
+    for (const auto& serial : serials)
+      all = all && std::any_of(cameras.begin(), cameras.end(), [&](const auto& c) { return c.serial == serial; });
+    if (all) break;
+  }
+  return cameras;
+}
+
 struct Camera::Aravis {
   ArvCamera* camera = nullptr;
   ArvStream* stream = nullptr;
@@ -87,7 +101,8 @@ struct Camera::Aravis {
   }
 };
 
-Camera::Camera(const CameraConfig& config, int index, const std::string& source)
+Camera::Camera(const CameraConfig& config, int index, const std::string& source,
+               const std::vector<CameraDescription>& discovered)
     : arv_(std::make_unique<Aravis>()), config_(config), index_(index) {
   GErrorSlot error;
   arv_->serial = config.serial;
@@ -100,7 +115,7 @@ Camera::Camera(const CameraConfig& config, int index, const std::string& source)
     arv_->address = "in-process";
   } else {
     std::string found;
-    for (const auto& c : list_cameras()) {
+    for (const auto& c : discovered) {
       if (c.serial == config.serial) {
         arv_->camera = arv_camera_new(c.id.c_str(), &error);
         arv_->address = c.address;

@@ -19,10 +19,16 @@ int64_t now_ns() {
 }  // namespace
 
 RigStream::RigStream(const RigConfig& rig, Trigger trigger) : rig_(rig), trigger_(trigger) {
+  std::vector<CameraDescription> discovered;
+  if (rig.source == "aravis") {
+    std::vector<std::string> serials;
+    for (const auto& c : rig.cameras) serials.push_back(c.serial);
+    discovered = discover_cameras(serials);
+  }
   std::string refused;
   for (size_t c = 0; c < rig.cameras.size(); ++c) {
     const auto& config = rig.cameras[c];
-    cameras_.push_back(std::make_unique<Camera>(config, int(c), rig.source));
+    cameras_.push_back(std::make_unique<Camera>(config, int(c), rig.source, discovered));
     for (const auto& problem : cameras_.back()->configure(config.settings, trigger))
       refused += "\n  camera " + config.name + " (serial " + config.serial + "): " + problem;
     unwrappers_.emplace_back(16);  // GigE Vision 1.x block ids are 16-bit; wider counters never wrap here
@@ -49,7 +55,11 @@ void RigStream::start(SetCallback on_set, LostCallback on_lost) {
   started_ns_ = now_ns();
   running_ = true;
   for (size_t c = 0; c < cameras_.size(); ++c) threads_.emplace_back([this, c] { grab(int(c)); });
-  if (trigger_ == Trigger::software) threads_.emplace_back([this] { fire_software_triggers(); });
+  if (trigger_ == Trigger::software) {
+    const auto first = std::chrono::steady_clock::now();
+    for (size_t c = 0; c < cameras_.size(); ++c)
+      threads_.emplace_back([this, c, first] { fire_software_triggers(int(c), first); });
+  }
 }
 
 void RigStream::stop() {
@@ -83,14 +93,16 @@ void RigStream::grab(int camera) {
   }
 }
 
-void RigStream::fire_software_triggers() {
+// A thread per camera: a camera that stops answering blocks only its own
+// trigger. The commands still reach the cameras milliseconds apart: never a
+// synchronised rig.
+void RigStream::fire_software_triggers(int camera, std::chrono::steady_clock::time_point first) {
   const auto period = std::chrono::nanoseconds(int64_t(1e9 / rig_.settings.frame_rate));
-  auto next = std::chrono::steady_clock::now();
-  while (running_) {
-    // One camera after another, milliseconds apart: never a synchronised rig.
-    for (size_t c = 0; c < cameras_.size(); ++c)
-      if (!lost_[c]) cameras_[c]->software_trigger();
+  auto next = first;
+  while (running_ && !lost_[camera]) {
+    cameras_[camera]->software_trigger();
     next += period;
+    if (next < std::chrono::steady_clock::now()) next = std::chrono::steady_clock::now();  // no burst after a stall
     std::this_thread::sleep_until(next);
   }
 }

@@ -1,10 +1,11 @@
 #pragma once
 // Every camera of the rig streaming at once: opens and configures them (an
 // Error lists every refused setting of every camera), runs one grabber
-// thread per camera and, for the software trigger, a trigger thread; groups
+// thread per camera and, for the software trigger, a trigger thread per camera; groups
 // the frames into frame sets and declares a camera lost when its control
 // channel drops or it sends nothing for sync.camera_timeout_ms.
 #include <atomic>
+#include <chrono>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -47,7 +48,7 @@ class RigStream {
 
  private:
   void grab(int camera);
-  void fire_software_triggers();
+  void fire_software_triggers(int camera, std::chrono::steady_clock::time_point first);
   int64_t key_of(const Frame& frame);
   void deliver(std::vector<FrameSet> sets);
   void lose(int camera, const std::string& reason);

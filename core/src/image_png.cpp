@@ -177,7 +177,9 @@ void write_png_rows(const PixelView& view, const fs::path& target, const fs::pat
   if (structs.png) structs.info = png_create_info_struct(structs.png);
   if (!structs.info) throw Error(file, "libpng could not start");
   if (!encode(structs.png, structs.info, fp.get(), &layout, rows.data(), compression)) {
-    throw Error(file, std::string("could not be written as PNG (") + message.text + ")");
+    // libpng says only "Write Error"; the cause (e.g. a full disk) is in errno.
+    const std::string cause = std::ferror(fp.get()) ? std::string(": ") + std::strerror(errno) : "";
+    throw Error(file, std::string("could not be written as PNG (") + message.text + cause + ")");
   }
   if (std::fclose(fp.release()) != 0) throw Error(file, std::string("could not be written (") + std::strerror(errno) + ")");
 }

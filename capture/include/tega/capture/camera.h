@@ -19,6 +19,9 @@ struct CameraDescription {
   std::string id, vendor, model, serial, interface, address;
 };
 std::vector<CameraDescription> list_cameras();
+// Discovery again while a wanted serial is missing: GigE Vision discovery is
+// UDP broadcast, and a reply can get lost.
+std::vector<CameraDescription> discover_cameras(const std::vector<std::string>& serials);
 
 enum class Trigger { hardware, software, free_run };
 Trigger parse_trigger(const std::string& name);  // hardware | software | free
@@ -26,10 +29,11 @@ std::string to_string(Trigger trigger);
 
 class Camera {
  public:
-  // source "aravis": the camera with config.serial among those Aravis
-  // discovers (an Error lists the serials it found otherwise); "fake": a new
-  // in-process Aravis simulated camera with that serial.
-  Camera(const CameraConfig& config, int index, const std::string& source);
+  // source "aravis": the camera with config.serial among `discovered` (an
+  // Error lists the serials found otherwise); "fake": a new in-process Aravis
+  // simulated camera with that serial.
+  Camera(const CameraConfig& config, int index, const std::string& source,
+         const std::vector<CameraDescription>& discovered);
   ~Camera();
   Camera(const Camera&) = delete;
   Camera& operator=(const Camera&) = delete;
