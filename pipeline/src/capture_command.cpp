@@ -83,8 +83,6 @@ void add_session(CLI::App& capture, const std::shared_ptr<CaptureArguments>& arg
   cmd->callback([args] {
     capture::SessionOptions options;
     load_options(options, args->config, "capture");
-    if (!options.rig.empty() && std::filesystem::path(options.rig).is_relative())
-      options.rig = (std::filesystem::path(args->config).parent_path() / options.rig).string();
     capture::run_session(options, args->out);
   });
 }

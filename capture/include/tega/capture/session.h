@@ -28,7 +28,7 @@ struct SessionOptions {
   std::vector<SessionTake> takes;
   template <class V>
   void visit(V& v) {
-    v("rig", rig, "Rig config file (relative paths are relative to the config file).");
+    v("rig", rig, "Rig config file (docs/capture.md#the-rig-config).");
     v("trigger", trigger, "hardware, software or free.");
     v("takes", takes, "The takes to record, in order; each needs frames or seconds.");
   }
