@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <set>
 
+#include "json_file.h"
 #include "tega/core/error.h"
 #include "tega/core/files.h"
 #include "tega/core/image_header.h"
@@ -18,14 +19,6 @@ namespace {
 constexpr const char* kManifest = "dataset.json";
 constexpr const char* kFormat = "tega-dataset";
 constexpr int kVersion = 1;
-
-json parse_manifest(const fs::path& file) {
-  try {
-    return json::parse(read_text_file(file));
-  } catch (const json::exception& e) {
-    throw Error(file, std::string("is not valid JSON: ") + e.what());
-  }
-}
 
 template <class T>
 T field(const json& object, const char* key, const fs::path& file, const std::string& where) {
@@ -100,7 +93,7 @@ Vertices Dataset::load_mesh(const std::string& frame_id) const {
 Dataset read_dataset(const fs::path& root) {
   const fs::path file = root / kManifest;
   if (!fs::exists(file)) throw Error(root, "is not a tega dataset (no dataset.json)");
-  const json manifest = parse_manifest(file);
+  const json manifest = detail::read_json_file(file);
   if (manifest.value("format", "") != kFormat) throw Error(file, "is not a tega dataset manifest (format)");
   if (manifest.value("version", 0) != kVersion) {
     throw Error(file, "has dataset version " + std::to_string(manifest.value("version", 0)) +

@@ -7,6 +7,7 @@
 #include <optional>
 #include <set>
 
+#include "json_file.h"
 #include "tega/core/error.h"
 #include "tega/core/files.h"
 #include "tega/core/image_header.h"
@@ -21,14 +22,6 @@ constexpr const char* kTakeFile = "take.json";
 constexpr const char* kCaptureFile = "capture.json";
 constexpr const char* kCaptureFormat = "tega-capture";
 constexpr int kCaptureVersion = 1;
-
-json parse_json(const fs::path& file) {
-  try {
-    return json::parse(read_text_file(file));
-  } catch (const json::exception& e) {
-    throw Error(file, std::string("is not valid JSON: ") + e.what());
-  }
-}
 
 // `where` names the enclosing entry in messages, e.g. "takes[2]"; "" at the top level.
 template <class T>
@@ -88,7 +81,7 @@ bool TakeInfo::has_image(const std::string& camera, int frame) const {
 
 TakeInfo read_take(const fs::path& take_folder) {
   const fs::path file = take_folder / kTakeFile;
-  const json j = parse_json(file);
+  const json j = detail::read_json_file(file);
   TakeInfo t;
   t.name = field<std::string>(j, "name", file);
   t.kind = field<std::string>(j, "kind", file);
@@ -185,7 +178,7 @@ void validate_take(const TakeInfo& t) {
 CaptureInfo read_capture(const fs::path& capture_root) {
   const fs::path file = capture_root / kCaptureFile;
   if (!fs::exists(file)) throw Error(capture_root, "is not a tega capture (no capture.json)");
-  const json j = parse_json(file);
+  const json j = detail::read_json_file(file);
   check_capture_format(j, file);
   CaptureInfo c;
   c.root = capture_root;
@@ -235,7 +228,7 @@ void record_take_in_capture(const fs::path& capture_root, const TakeInfo& take, 
   const fs::path file = capture_root / kCaptureFile;
   json capture;
   if (fs::exists(file)) {
-    capture = parse_json(file);
+    capture = detail::read_json_file(file);
     check_capture_format(capture, file);
   } else {
     capture = {{"format", kCaptureFormat}, {"version", kCaptureVersion}, {"generator", generator},
