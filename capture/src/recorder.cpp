@@ -51,6 +51,17 @@ void check_free_space(const fs::path& folder, double min_free_mb) {
                             std::to_string(int(min_free_mb)) + ": free some space or record elsewhere");
 }
 
+// A preview that cannot be written (a bad path, a full disk) must not end the take.
+void update_preview(const std::optional<FrameSet>& latest, const std::vector<PixelFormatInfo>& formats,
+                    const fs::path& file) {
+  if (!latest) return;
+  try {
+    write_contact_sheet(*latest, formats, file);
+  } catch (const std::exception& e) {
+    logging::warn("preview not updated: %s", e.what());
+  }
+}
+
 // The recorded frame set handling and the bookkeeping the manifest needs.
 class Recording {
  public:
@@ -102,10 +113,6 @@ class Recording {
 
   void event(double t, std::string message) { files_.event(t, std::move(message)); }
 
-  int frames() const {
-    std::lock_guard lock(mutex_);
-    return frames_;
-  }
   bool any_lost() const {
     std::lock_guard lock(mutex_);
     for (const auto& c : outcome_.cameras)
@@ -199,8 +206,15 @@ TakeOutcome record_take(const RigConfig& rig, const TakeRequest& request, const 
                 request.kind.c_str(), to_string(request.trigger).c_str(),
                 request.trigger == Trigger::hardware ? "" : ", NOT synchronised", rig.cameras.size(),
                 final_folder.c_str());
-  stream.start([&](FrameSet set) { recording.on_set(std::move(set)); },
-               [&](int camera, const std::string& reason) { recording.camera_lost(camera, reason, seconds_since(start)); });
+  try {
+    stream.start([&](FrameSet set) { recording.on_set(std::move(set)); },
+                 [&](int camera, const std::string& reason) { recording.camera_lost(camera, reason, seconds_since(start)); });
+  } catch (...) {
+    stream.stop();
+    writer.finish();
+    remove_tree(recording_folder);  // nothing was recorded: leave no interrupted recording behind
+    throw;
+  }
 
   while (true) {
     std::this_thread::sleep_for(kLoopInterval);
@@ -226,7 +240,7 @@ TakeOutcome record_take(const RigConfig& rig, const TakeRequest& request, const 
       last_status = Clock::now();
     }
     if (!request.preview.empty() && Clock::now() - last_preview >= kPreviewInterval) {
-      if (auto latest = recording.latest()) write_contact_sheet(*latest, stream.formats(), request.preview);
+      update_preview(recording.latest(), stream.formats(), request.preview);
       last_preview = Clock::now();
     }
   }
@@ -237,8 +251,7 @@ TakeOutcome record_take(const RigConfig& rig, const TakeRequest& request, const 
   status.finish();
   recording.event(seconds_since(start), "acquisition stopped: " + outcome.stop_reason +
                                             (outcome.error.empty() ? "" : " (" + outcome.error + ")"));
-  if (!request.preview.empty())
-    if (auto latest = recording.latest()) write_contact_sheet(*latest, stream.formats(), request.preview);
+  if (!request.preview.empty()) update_preview(recording.latest(), stream.formats(), request.preview);
 
   outcome.seconds = seconds_since(start);
   outcome.bytes = writer.bytes_written();
