@@ -131,7 +131,7 @@ class Recording {
     std::vector<std::string> lines;
     char line[256];
     std::snprintf(line, sizeof line, "take %s  %.1f s  %d frame sets written  %lld incomplete  %lld dropped  %.1f MB/s",
-                  request_.name.c_str(), elapsed, frames_, (long long)outcome_.incomplete_sets,
+                  request_.name.c_str(), elapsed, frames_.load(), (long long)outcome_.incomplete_sets,
                   (long long)(outcome_.incomplete_dropped + outcome_.writer_full_dropped),
                   elapsed > 0 ? writer_.bytes_written() / elapsed / 1e6 : 0.0);
     lines.push_back(line);
@@ -160,7 +160,7 @@ class Recording {
   mutable std::mutex mutex_;
   TakeFiles files_;
   TakeOutcome outcome_;
-  int frames_ = 0;
+  std::atomic<int> frames_{0};  // the main loop reads it to stop at --frames
   std::optional<FrameSet> latest_;
   Clock::time_point last_status_ = Clock::now();
   std::vector<uint64_t> received_before_;

@@ -54,7 +54,11 @@ void add_list(CLI::App& capture) {
   auto* cmd = capture.add_subcommand("list", "List the cameras Aravis sees: vendor, model, serial, interface, address.");
   cmd->callback([] {
     const auto cameras = capture::list_cameras();
-    if (cameras.empty()) std::cout << "no cameras found (GigE Vision cameras must be on a reachable subnet)\n";
+    if (cameras.empty()) {
+      std::cout << "no cameras found (GigE Vision cameras must be on a reachable subnet)\n";
+      return;
+    }
+    std::printf("%-20s %-24s %-16s %-10s %s\n", "vendor", "model", "serial", "interface", "address");
     for (const auto& c : cameras)
       std::printf("%-20s %-24s %-16s %-10s %s\n", c.vendor.c_str(), c.model.c_str(), c.serial.c_str(),
                   c.interface.c_str(), c.address.c_str());
@@ -110,8 +114,7 @@ void add_capture_command(CLI::App& app) {
   cmd->require_subcommand(0, 1);
   cmd->add_option("--rig", args->rig, "Rig config (YAML): cameras by serial, settings, sync, writer.");
   cmd->add_option("--take", args->take, "Take name: the folder under CAPTURE/takes/.");
-  cmd->add_option("--kind", args->kind, "performance (default), calibration or clean_plate.")
-      ->check(CLI::IsMember({"performance", "calibration", "clean_plate"}));
+  cmd->add_option("--kind", args->kind, "performance (default), calibration or clean_plate.");
   cmd->add_option("--out", args->out, "Capture folder (created if needed; capture.json lists its takes).");
   auto* frames = cmd->add_option("--frames", args->frames, "Stop after this many frame sets.");
   cmd->add_option("--seconds", args->seconds, "Stop after this many seconds.")->excludes(frames);

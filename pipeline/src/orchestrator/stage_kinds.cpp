@@ -37,27 +37,6 @@ std::vector<StageKind> make_stage_kinds() {
   synth.arguments = [](const ShardPaths& p) { return with_config({"--out", (p.output / "capture").string()}, p); };
   kinds.push_back(synth);
 
-  StageKind capture;
-  capture.name = "capture";
-  capture.summary = "records the session's takes from the GenICam rig through Aravis (tega capture session)";
-  capture.subcommand = {"capture", "session"};
-  capture.provides = {{"capture", "capture"}};
-  capture.options_section = "capture";
-  capture.path_options = {"rig"};
-  capture.arguments = [](const ShardPaths& p) { return with_config({"--out", (p.output / "capture").string()}, p); };
-  kinds.push_back(capture);
-
-  StageKind capture_check;
-  capture_check.name = "capture_check";
-  capture_check.summary = "checks a capture the way later stages read it (tega capture validate)";
-  capture_check.subcommand = {"capture", "validate"};
-  capture_check.needs = {"capture"};
-  capture_check.options_as = OptionsAs::none;
-  capture_check.arguments = [](const ShardPaths& p) {
-    return std::vector<std::string>{"--capture", p.artifacts.at("capture").string()};
-  };
-  kinds.push_back(capture_check);
-
   StageKind ingest;
   ingest.name = "ingest_multiface";
   ingest.summary = "a Multiface capture converted to a dataset (tega ingest multiface)";
@@ -130,6 +109,27 @@ std::vector<StageKind> make_stage_kinds() {
                       p);
   };
   kinds.push_back(render);
+
+  StageKind capture;
+  capture.name = "capture";
+  capture.summary = "records the session's takes from the GenICam rig through Aravis (tega capture session)";
+  capture.subcommand = {"capture", "session"};
+  capture.provides = {{"capture", "capture"}};
+  capture.options_section = "capture";
+  capture.path_options = {"rig"};
+  capture.arguments = [](const ShardPaths& p) { return with_config({"--out", (p.output / "capture").string()}, p); };
+  kinds.push_back(capture);
+
+  StageKind capture_check;
+  capture_check.name = "capture_check";
+  capture_check.summary = "checks a capture the way later stages read it (tega capture validate)";
+  capture_check.subcommand = {"capture", "validate"};
+  capture_check.needs = {"capture"};
+  capture_check.options_as = OptionsAs::none;
+  capture_check.arguments = [](const ShardPaths& p) {
+    return std::vector<std::string>{"--capture", p.artifacts.at("capture").string()};
+  };
+  kinds.push_back(capture_check);
 
   kinds.push_back(not_implemented("calibrate", "calibrates the rig from the ChArUco take (OpenCV + Ceres)",
                                   {"capture"}, {{"rig", "rig.json"}}));
