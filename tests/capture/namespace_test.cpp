@@ -60,7 +60,7 @@ TEST(GigEVision, ThirteenSimulatedCamerasAreListedRecordedAndOneIsLostMidTake) {
     rig += line;
   }
   test::write_text(dir / "rig.yaml", rig);
-  // Camera i answers on 127.0.1.i; the fifth camera's process is killed 2.5 s into the second take.
+  // Camera i answers on 127.0.1.i; the fifth camera's process is killed 2 s into the second take's recording.
   const int status = run_in_namespace("-rn", dir.path(), R"(
 set -u
 tega=$1
@@ -77,7 +77,8 @@ $tega capture --rig rig.yaml --take gige --frames 10 --trigger software --out ca
 echo $? > gige.rc
 $tega capture --rig rig.yaml --take lost --seconds 6 --trigger software --out capture > lost.log 2>&1 &
 recorder=$!
-sleep 2.5
+while [ ! -d capture/takes/lost.recording ]; do sleep 0.1; done
+sleep 2
 kill ${cameras[4]}
 wait $recorder
 echo $? > lost.rc
@@ -103,7 +104,7 @@ echo $? > validate.rc
   const auto manifest = nlohmann::json::parse(read_text(dir / "capture/takes/lost/manifest.json"));
   ASSERT_FALSE(manifest["cameras"][4]["lost"].is_null()) << manifest.dump(2);
   const int from = manifest["cameras"][4]["lost"]["from_frame"];
-  EXPECT_GT(from, 5);               // it delivered for the first 2.5 s
+  EXPECT_GT(from, 5);                 // it delivered for the first 2 s
   EXPECT_GT(lost.frames, from + 10);  // and the take went on without it for the rest
   ASSERT_EQ(lost.missing.count("cam04"), 1u);
   const auto& gap = lost.missing.at("cam04");
