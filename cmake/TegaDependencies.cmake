@@ -50,6 +50,15 @@ if(TEGA_WITH_OPENCV)
   endif()
 endif()
 
+# Ceres: the bundle adjustment of calibrate/ (which also needs OpenCV).
+set(TEGA_HAVE_CERES OFF)
+find_package(Ceres QUIET)
+if(Ceres_FOUND)
+  set(TEGA_HAVE_CERES ON)
+else()
+  message(STATUS "tega: Ceres not found (libceres-dev): calibrate/ is off")
+endif()
+
 set(TEGA_HAVE_ARAVIS OFF)
 if(TEGA_WITH_ARAVIS)
   find_package(PkgConfig QUIET)

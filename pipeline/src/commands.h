@@ -10,6 +10,7 @@ void add_dataset_command(CLI::App& app);
 void add_rig_command(CLI::App& app);
 void add_ingest_command(CLI::App& app);
 void add_capture_command(CLI::App& app);
+void add_calibrate_command(CLI::App& app);
 void add_train_command(CLI::App& app);
 void add_render_command(CLI::App& app);
 void add_eval_command(CLI::App& app);

@@ -27,6 +27,9 @@ int main(int argc, char** argv) {
 #ifdef TEGA_HAVE_CAPTURE
   tega::cli::add_capture_command(app);
 #endif
+#ifdef TEGA_HAVE_CALIBRATE
+  tega::cli::add_calibrate_command(app);
+#endif
 #ifdef TEGA_HAVE_TRAINER
   tega::cli::add_train_command(app);
 #endif

@@ -131,8 +131,24 @@ std::vector<StageKind> make_stage_kinds() {
   };
   kinds.push_back(capture_check);
 
-  kinds.push_back(not_implemented("calibrate", "calibrates the rig from the ChArUco take (OpenCV + Ceres)",
-                                  {"capture"}, {{"rig", "rig.json"}}));
+  // The capture's take named "calibration" (docs/calibration.md#in-the-pipeline).
+  StageKind calibrate;
+  calibrate.name = "calibrate";
+  calibrate.summary = "calibrates the rig from the capture's calibration take (tega calibrate)";
+  calibrate.subcommand = {"calibrate"};
+  calibrate.needs = {"capture"};
+  calibrate.provides = {{"rig", "rig.json"}};
+  calibrate.options_as = OptionsAs::flags;
+  calibrate.flag_options = {"board",          "init",       "world",     "world_camera",
+                            "world_board_frame", "robust_loss_px", "outlier_px", "free_k3", "refine_init_intrinsics",
+                            "min_views",      "threads"};
+  calibrate.path_options = {"board", "init"};
+  calibrate.arguments = [](const ShardPaths& p) {
+    return with_flags({"--take", (p.artifacts.at("capture") / "takes" / "calibration").string(), "--out",
+                       (p.output / "rig.json").string()},
+                      p);
+  };
+  kinds.push_back(calibrate);
   kinds.push_back(not_implemented("mvs", "reconstructs a mesh per frame (multi-view stereo)", {"capture", "rig"},
                                   {{"meshes", "meshes"}}));
   kinds.push_back(not_implemented("tracking", "fits the blendshape template to the per-frame meshes",

@@ -1,0 +1,141 @@
+#include "tega/calibrate/detection.h"
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "aruco_board.h"
+#include "tega/core/error.h"
+#include "tega/core/progress.h"
+#include "tega/core/thread_pool.h"
+
+namespace tega::calibrate {
+namespace {
+
+// The image in grey; a grey image is wrapped, not copied.
+cv::Mat grey_of(const Image8& image) {
+  const cv::Mat m(image.height, image.width, CV_8UC(image.channels), const_cast<uint8_t*>(image.pixels.data()));
+  cv::Mat grey;
+  switch (image.channels) {
+    case 1: return m;
+    case 2: cv::extractChannel(m, grey, 0); break;  // grey + alpha
+    case 3: cv::cvtColor(m, grey, cv::COLOR_RGB2GRAY); break;
+    case 4: cv::cvtColor(m, grey, cv::COLOR_RGBA2GRAY); break;
+    default: throw Error("detect_board: an image of " + std::to_string(image.channels) + " channels");
+  }
+  return grey;
+}
+
+// What detection needs of a board, made once: OpenCV's ChArUco board and
+// dictionary are only read while detecting, so every thread shares them.
+class Detector {
+ public:
+  explicit Detector(const Board& board)
+      : board_(board), charuco_(board.options.type == "charuco" ? detail::aruco_board(board.options) : nullptr) {}
+
+  BoardView detect(const cv::Mat& grey, int min_corners) const {
+    BoardView view = charuco_ ? detect_charuco(grey) : detect_chessboard(grey);
+    if (int(view.ids.size()) < min_corners) return {};
+    return view;
+  }
+
+ private:
+  BoardView detect_charuco(const cv::Mat& grey) const {
+    std::vector<std::vector<cv::Point2f>> marker_corners;
+    std::vector<int> marker_ids;
+    // Parameters per call: cheap, and nothing is shared that OpenCV might write.
+    cv::aruco::detectMarkers(grey, charuco_->dictionary, marker_corners, marker_ids,
+                             cv::aruco::DetectorParameters::create());
+    BoardView view;
+    if (marker_ids.empty()) return view;
+    std::vector<cv::Point2f> corners;
+    cv::aruco::interpolateCornersCharuco(marker_corners, marker_ids, grey, charuco_, corners, view.ids);
+    // OpenCV 4.6's ChArUco refinement returns corners half a pixel down and
+    // right of where they are (opencv/opencv#25539, fixed upstream later).
+    for (const auto& c : corners) view.pixels.emplace_back(c.x - 0.5, c.y - 0.5);
+    return view;
+  }
+
+  BoardView detect_chessboard(const cv::Mat& grey) const {
+    const int nx = board_.options.squares_x - 1, ny = board_.options.squares_y - 1;
+    std::vector<cv::Point2f> found;
+    if (!cv::findChessboardCorners(grey, cv::Size(nx, ny), found,
+                                   cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE))
+      return {};
+    const auto at = [&](int x, int y) { return found[y * nx + x]; };
+
+    // The refinement window must not reach the next corner.
+    double spacing = INFINITY;
+    for (int y = 0; y < ny; ++y)
+      for (int x = 0; x < nx; ++x) {
+        if (x + 1 < nx) spacing = std::min(spacing, cv::norm(at(x + 1, y) - at(x, y)));
+        if (y + 1 < ny) spacing = std::min(spacing, cv::norm(at(x, y + 1) - at(x, y)));
+      }
+    const int half = std::clamp(int(spacing / 2), 1, 5);  // 11 x 11 at most
+    cv::cornerSubPix(grey, found, cv::Size(half, half), cv::Size(-1, -1),
+                     cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 50, 0.001));
+
+    // Row by row, as the ids run: OpenCV starts at the corner next to the
+    // black top-left square of a board with squares_x + squares_y odd,
+    // whichever way it is turned (tests/calibrate/detection_test.cpp); a
+    // symmetric board starts at the top of the image (make_board warns).
+    BoardView view;
+    for (int id = 0; id < nx * ny; ++id) {
+      view.ids.push_back(id);
+      view.pixels.emplace_back(found[id].x, found[id].y);
+    }
+    return view;
+  }
+
+  const Board& board_;
+  cv::Ptr<cv::aruco::CharucoBoard> charuco_;
+};
+
+// Raw Bayer frames, made grey without moving a pixel. OpenCV names a mosaic
+// by its second row, GenICam by its first.
+cv::Mat grey_of_bayer(const Image8& mosaic, const std::string& pattern) {
+  const int code = pattern == "RG"   ? cv::COLOR_BayerBG2GRAY
+                   : pattern == "BG" ? cv::COLOR_BayerRG2GRAY
+                   : pattern == "GB" ? cv::COLOR_BayerGR2GRAY
+                                     : cv::COLOR_BayerGB2GRAY;
+  cv::Mat grey;
+  cv::cvtColor(grey_of(mosaic), grey, code);
+  return grey;
+}
+
+}  // namespace
+
+BoardView detect_board(const Image8& image, const Board& board, int min_corners) {
+  return Detector(board).detect(grey_of(image), min_corners);
+}
+
+std::vector<BoardView> detect_board_in_take(const TakeInfo& take, const Board& board, int threads, int min_corners) {
+  std::vector<std::pair<int, int>> images;  // camera, frame: in the order of the result
+  for (int c = 0; c < int(take.cameras.size()); ++c)
+    for (int f = 0; f < take.frames; ++f)
+      if (take.has_image(take.cameras[c], f)) images.emplace_back(c, f);
+  const bool bayer = take.pixel_format.starts_with("Bayer");
+
+  const Detector detector(board);
+  std::vector<BoardView> views(images.size());
+  Progress progress("detecting board", int64_t(images.size()), "images");
+  ThreadPool pool(threads);
+  pool.parallel_for(0, int64_t(images.size()), [&](int64_t i) {
+    const auto [camera, frame] = images[i];
+    const Image8 image = read_image_u8(take.image_path(take.cameras[camera], frame));
+    const cv::Mat grey =
+        bayer && image.channels == 1 ? grey_of_bayer(image, take.pixel_format.substr(5, 2)) : grey_of(image);
+    views[i] = detector.detect(grey, min_corners);
+    views[i].camera = camera;
+    views[i].frame = frame;
+    progress.advance();
+  });
+  progress.finish();
+  std::erase_if(views, [](const BoardView& v) { return v.ids.empty(); });
+  return views;
+}
+
+}  // namespace tega::calibrate
