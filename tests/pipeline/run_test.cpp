@@ -268,6 +268,27 @@ TEST(TegaRun, StartsFromATakeRecordedFromSimulatedCameras) {
   EXPECT_EQ(shard_state(status, "check", "default"), "done");
 }
 
+TEST(TegaRun, CalibratesTheRigFromTheCapturesCalibrationTake) {
+  REQUIRE_SYNTH();
+  if (!tega_has_command({"calibrate"})) GTEST_SKIP() << "this build has no `tega calibrate` (OpenCV + Ceres)";
+  TempDir dir;
+  write_text(dir / "board.yaml", "type: charuco\nsquares_x: 7\nsquares_y: 5\nsquare_m: 0.04\nmarker_m: 0.03\n");
+  write_text(dir / "studio.yaml",
+             "workspace: ws\nstages:\n"
+             "  synth:\n    options:\n"
+             "      studio: {cameras: 3, width: 480, height: 360}\n      calibration_frames: 10\n"
+             "      frames: 1\n      takes: [expressions]\n      test_takes: []\n      supersampling: 1\n"
+             "      fine_subdivisions: 0\n      write_fine_meshes: false\n"
+             "  calibrate: {after: synth, options: {board: board.yaml}}\n");
+  const auto r = run_tega({"run", (dir / "studio.yaml").string()}, dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const json status = status_json(dir / "ws", dir.path());
+  EXPECT_EQ(shard_state(status, "calibrate", "default"), "done");
+  const json report = json::parse(read_text_file(dir / "ws/calibrate/default/rig.report.json"));
+  EXPECT_EQ(report["cameras"].size(), 3u);
+  EXPECT_LE(report["rms_px"].get<double>(), 0.5);
+}
+
 TEST(TegaRun, TheShippedConfigsAreValidGraphs) {
   for (const char* name : {"demo.yaml", "studio13-capture.yaml"}) {
     TempDir dir;
