@@ -251,26 +251,42 @@ void the_command_writes_the_rig_its_report_and_its_exports(const fs::path& root)
   EXPECT_FALSE(fs::exists(out / "wrong/rig.json"));
 }
 
-// Rendered corners carry ~0.2 px of detection noise: with this CI-sized take
-// (40 poses at 640 x 480) the principal points and rotations of the 70 mm
-// lenses are only this well determined (docs/calibration.md#accuracy; the
-// projected test above shows the solver meets the tight bounds once the data
-// allows).
-constexpr Tolerances kRenderedTake{0.002, 6.0, 0.002, 0.3};
+// The CI-sized take (40 poses at 640 x 480) pins the principal points and
+// rotations of the 70 mm lenses down less tightly than bench/calibrate's
+// 200 poses at 1024 x 768, which meet the tight bounds
+// (docs/calibration.md#accuracy-and-speed), worst for the outer cameras that
+// see the board obliquely: the typical camera is held to tight bounds, the
+// worst to loose ones. Focal lengths and centres meet the tight bounds.
+void expect_rendered_rig_near(const Rig& calibrated, const Rig& truth, const RigidTransform& truth_world_to_calibrated,
+                              double worst_rotation_deg) {
+  expect_rig_near(calibrated, truth, truth_world_to_calibrated, {0.002, 10.0, 0.001, worst_rotation_deg});
+  std::vector<double> principal, rotation;
+  for (size_t c = 0; c < truth.cameras.size(); ++c) {
+    const Camera& got = calibrated.cameras[c];
+    const Camera& want = truth.cameras[c];
+    principal.push_back((got.K.block<2, 1>(0, 2) - want.K.block<2, 1>(0, 2)).norm());
+    rotation.push_back(rotation_deg(got.world_to_camera.R, (want.world_to_camera * truth_world_to_calibrated.inverse()).R));
+  }
+  std::nth_element(principal.begin(), principal.begin() + principal.size() / 2, principal.end());
+  std::nth_element(rotation.begin(), rotation.begin() + rotation.size() / 2, rotation.end());
+  EXPECT_LT(principal[principal.size() / 2], 1.5) << "median principal point error, px";
+  EXPECT_LT(rotation[rotation.size() / 2], 0.08) << "median rotation error, degrees";
+}
 
 TEST_F(RenderedStudio, ThirteenCamerasMatchGroundTruthAndTheCommandWritesItsReport) {
   const TakeInfo take = read_take(root() / "takes/calibration");
   const Rig truth = read_rig_json(root() / "rig.json");
   const auto views = detect_board_in_take(take, studio_board());
   const Calibration result = calibrate_rig(views, studio_board(), sizes_of(truth), CalibrationOptions{});
-  expect_rig_near(result.rig, truth, truth.cameras[0].world_to_camera, kRenderedTake);
+  expect_rendered_rig_near(result.rig, truth, truth.cameras[0].world_to_camera, 0.5);
   EXPECT_LE(result.rms_px, 0.3);
 
   CalibrationOptions board_world;
   board_world.world = "board";
   const Calibration on_board = calibrate_rig(views, studio_board(), sizes_of(truth), board_world);
   const int frame = std::stoi(on_board.world.substr(on_board.world.rfind(' ') + 1));
-  expect_rig_near(on_board.rig, truth, board_pose(root(), frame).inverse(), kRenderedTake);
+  // With the world on the board, one board pose's own error turns every camera.
+  expect_rendered_rig_near(on_board.rig, truth, board_pose(root(), frame).inverse(), 0.6);
 
   the_command_writes_the_rig_its_report_and_its_exports(root());
 }
