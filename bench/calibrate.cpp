@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <thread>
 
 #include "tega/calibrate/calibration.h"
@@ -16,6 +18,28 @@
 
 namespace fs = std::filesystem;
 using namespace tega;
+
+namespace {
+
+// The worst camera's errors against the virtual studio's ground truth, expressed in the calibration's world.
+void report_against_truth(const char* label, const Rig& calibrated, const Rig& truth,
+                          const RigidTransform& truth_world_to_calibrated) {
+  double focal = 0, principal = 0, centre = 0, rotation = 0;
+  for (size_t c = 0; c < truth.cameras.size(); ++c) {
+    const Camera& got = calibrated.cameras[c];
+    const Camera& want = truth.cameras[c];
+    const RigidTransform want_pose = want.world_to_camera * truth_world_to_calibrated.inverse();
+    focal = std::max({focal, std::abs(got.K(0, 0) / want.K(0, 0) - 1), std::abs(got.K(1, 1) / want.K(1, 1) - 1)});
+    principal = std::max(principal, (got.K.block<2, 1>(0, 2) - want.K.block<2, 1>(0, 2)).norm());
+    centre = std::max(centre, (got.center() - (-want_pose.R.transpose() * want_pose.t)).norm());
+    rotation = std::max(rotation, Eigen::AngleAxisd(got.world_to_camera.R * want_pose.R.transpose()).angle());
+  }
+  std::printf("worst camera against ground truth, %s: focal %.3f %%, principal point %.2f px, centre %.2f mm, "
+              "rotation %.3f deg\n",
+              label, 100 * focal, principal, 1000 * centre, rotation * 180 / M_PI);
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"Calibration time: detection and bundle adjustment."};
@@ -69,19 +93,15 @@ int main(int argc, char** argv) {
   std::printf("calibration: %6.1f s  (intrinsics, pose graph, bundle adjustment twice; rms %.3f px, %d outliers)\n",
               result.seconds, result.rms_px, result.outliers);
   std::printf("total:       %6.1f s\n", detection + result.seconds);
-  // Against the virtual studio's ground truth, in the first camera's frame.
-  double focal = 0, principal = 0, centre = 0, rotation = 0;
-  const RigidTransform to_calibrated = truth.cameras[0].world_to_camera;
-  for (size_t c = 0; c < truth.cameras.size(); ++c) {
-    const Camera& got = result.rig.cameras[c];
-    const Camera& want = truth.cameras[c];
-    const RigidTransform want_pose = want.world_to_camera * to_calibrated.inverse();
-    focal = std::max({focal, std::abs(got.K(0, 0) / want.K(0, 0) - 1), std::abs(got.K(1, 1) / want.K(1, 1) - 1)});
-    principal = std::max(principal, (got.K.block<2, 1>(0, 2) - want.K.block<2, 1>(0, 2)).norm());
-    centre = std::max(centre, (got.center() - (-want_pose.R.transpose() * want_pose.t)).norm());
-    rotation = std::max(rotation, Eigen::AngleAxisd(got.world_to_camera.R * want_pose.R.transpose()).angle());
-  }
-  std::printf("worst camera against ground truth: focal %.3f %%, principal point %.2f px, centre %.2f mm, "
-              "rotation %.3f deg\n",
-              100 * focal, principal, 1000 * centre, rotation * 180 / M_PI);
+  report_against_truth("world on cam00", result.rig, truth, truth.cameras[0].world_to_camera);
+
+  options.world = "board";
+  const auto on_board = calibrate::calibrate_rig(views, board, sizes, options);
+  const int frame = std::stoi(on_board.world.substr(on_board.world.rfind(' ') + 1));
+  const auto gt = nlohmann::json::parse(std::ifstream(root / "ground_truth/calibration/frames.json"));
+  Eigen::Matrix<double, 3, 4> board_to_world;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) board_to_world(r, c) = gt["frames"][frame]["board_to_world"][r][c];
+  report_against_truth(("world on the " + on_board.world).c_str(), on_board.rig, truth,
+                       RigidTransform::from_matrix(board_to_world).inverse());
 }
