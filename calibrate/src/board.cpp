@@ -3,10 +3,9 @@
 #include <cmath>
 #include <map>
 
-#include <spdlog/spdlog.h>
-
 #include "aruco_board.h"
 #include "tega/core/error.h"
+#include "tega/core/log.h"
 #include "tega/core/options.h"
 
 namespace tega::calibrate {
@@ -63,10 +62,10 @@ Board make_board(const BoardOptions& o, const std::string& source) {
            " markers, fewer than the board's " + std::to_string(markers));
   }
   if (o.type == "chessboard" && (o.squares_x + o.squares_y) % 2 == 0)
-    spdlog::warn("{}: a {} x {} chessboard looks the same turned half a turn, so its corner ids follow the image "
-                 "(first row at the top) and differ between cameras that see it turned; one odd and one even "
-                 "count (e.g. 10 x 7) tells its ends apart",
-                 source, o.squares_x, o.squares_y);
+    logging::warn("%s: a %d x %d chessboard looks the same turned half a turn, so its corner ids follow the image "
+                  "(first row at the top) and differ between cameras that see it turned; one odd and one even "
+                  "count (e.g. 10 x 7) tells its ends apart",
+                  source.c_str(), o.squares_x, o.squares_y);
   Board board{o, {}};
   for (int y = 1; y < o.squares_y; ++y)
     for (int x = 1; x < o.squares_x; ++x) board.corners.emplace_back(x * o.square_m, y * o.square_m, 0.0);
