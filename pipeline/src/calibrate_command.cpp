@@ -2,6 +2,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <sstream>
 
 #include "commands.h"
 #include "tega/calibrate/calibration.h"
@@ -10,6 +11,7 @@
 #include "tega/core/image.h"
 #include "tega/core/image_header.h"
 #include "tega/core/log.h"
+#include "tega/core/options.h"
 #include "tega/core/rig.h"
 
 namespace tega::cli {
@@ -17,10 +19,30 @@ namespace tega::cli {
 namespace {
 
 struct CalibrateArguments {
-  std::string take, board, out, init;
+  std::string take, board, out, init, config;
+  bool print_options = false;
   int dpi = 300;
-  calibrate::CalibrationOptions options;
+  calibrate::CalibrationOptions options;  // defaults, then the flags given
 };
+
+// The options: defaults, then the --config file's `calibrate` section, then the flags given.
+calibrate::CalibrationOptions options_of(const CLI::App& cmd, const CalibrateArguments& args) {
+  if (args.config.empty()) return args.options;
+  calibrate::CalibrationOptions options;
+  load_options(options, args.config, "calibrate");
+  const auto& flags = args.options;
+  const auto given = [&](const char* flag) { return cmd.get_option(flag)->count() > 0; };
+  if (given("--world")) options.world = flags.world;
+  if (given("--world-camera")) options.world_camera = flags.world_camera;
+  if (given("--world-board-frame")) options.world_board_frame = flags.world_board_frame;
+  if (given("--robust-loss-px")) options.robust_loss_px = flags.robust_loss_px;
+  if (given("--outlier-px")) options.outlier_px = flags.outlier_px;
+  if (given("--free-k3")) options.fix_k3 = flags.fix_k3;
+  if (given("--refine-init-intrinsics")) options.refine_init_intrinsics = flags.refine_init_intrinsics;
+  if (given("--min-views")) options.min_views = flags.min_views;
+  if (given("--threads")) options.threads = flags.threads;
+  return options;
+}
 
 // Each camera's image size, from its first image of the take.
 std::vector<calibrate::CameraSize> camera_sizes(const TakeInfo& take) {
@@ -83,9 +105,19 @@ void add_calibrate_command(CLI::App& app) {
                 "With --init: solve for the intrinsics too (needs a full calibration take); by default they stay.");
   cmd->add_option("--min-views", o.min_views, "Board views a camera needs for its own intrinsics (default 4).");
   cmd->add_option("--threads", o.threads, "Threads for detection and the solver (default: all).");
+  cmd->add_option("--config", args->config,
+                  "YAML file whose `calibrate` section sets options (see --print-options); flags given win.");
+  cmd->add_flag("--print-options", args->print_options, "Print every calibration option with its default and exit.");
   add_board_command(*cmd, args);
   cmd->callback([cmd, args] {
     if (!cmd->get_subcommands().empty()) return;
+    args->options = options_of(*cmd, *args);
+    if (args->print_options) {
+      std::cout << "calibrate:\n";
+      std::istringstream yaml(options_to_yaml(args->options));
+      for (std::string line; std::getline(yaml, line);) std::cout << "  " << line << "\n";
+      return;
+    }
     if (args->take.empty() || args->board.empty() || args->out.empty())
       throw Error("tega calibrate needs --take, --board and --out");
     if (args->options.world != "camera" && args->options.world != "board")

@@ -301,6 +301,22 @@ TEST(CalibrateCommand, APrintedBoardIsDetectedWhole) {
   EXPECT_EQ(detect_board(read_image_u8(out / "board.png"), board).ids.size(), board.corners.size());
 }
 
+TEST(CalibrateCommand, OptionsComeFromDefaultsThenTheConfigThenTheFlags) {
+  test::TempDir dir;
+  test::write_text(dir / "studio.yaml", "calibrate:\n  outlier_px: 3\n  world: board\n");
+  const auto r = test::run_tega("calibrate --config " + (dir / "studio.yaml").string() + " --world camera --print-options");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("outlier_px: 3"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("world: \"camera\""), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("min_views: 4"), std::string::npos) << r.output;
+
+  test::write_text(dir / "typo.yaml", "calibrate:\n  outlierpx: 3\n");
+  const auto typo = test::run_tega("calibrate --config " + (dir / "typo.yaml").string() + " --print-options");
+  EXPECT_NE(typo.exit_code, 0);
+  EXPECT_NE(typo.output.find("typo.yaml"), std::string::npos) << typo.output;
+  EXPECT_NE(typo.output.find("calibrate.outlierpx"), std::string::npos) << typo.output;
+}
+
 // OpenCV's sample photos of a real 9 x 6 chessboard (Debian opencv-doc).
 TEST(RealImages, SingleCameraIntrinsicsAgreeWithOpenCv) {
   const fs::path samples = "/usr/share/doc/opencv-doc/examples/data";
