@@ -1,7 +1,5 @@
 #include "tega/capture/recorder.h"
 
-#include <sys/statvfs.h>
-
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -9,6 +7,7 @@
 #include <mutex>
 #include <thread>
 
+#include "disk_space.h"
 #include "interrupt.h"
 #include "live_status.h"
 #include "preview.h"
@@ -43,10 +42,8 @@ void check_request(const TakeRequest& r) {
 }
 
 void check_free_space(const fs::path& folder, double min_free_mb) {
-  struct statvfs s {};
-  if (statvfs(folder.c_str(), &s) != 0) return;
-  const double free = double(s.f_bavail) * s.f_frsize / (1024.0 * 1024.0);
-  if (free < min_free_mb)
+  const double free = free_mb(folder);
+  if (free >= 0 && free < min_free_mb)
     throw Error(folder, "only " + std::to_string(int(free)) + " MB free, writer.min_free_mb is " +
                             std::to_string(int(min_free_mb)) + ": free some space or record elsewhere");
 }

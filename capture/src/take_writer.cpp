@@ -1,10 +1,9 @@
 #include "tega/capture/take_writer.h"
 
-#include <sys/statvfs.h>
-
 #include <cstdio>
 #include <cstring>
 
+#include "disk_space.h"
 #include "tega/core/error.h"
 #include "tega/core/image.h"
 #include "tega/core/thread_pool.h"
@@ -20,12 +19,6 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr int kSpaceCheckInterval = 32;  // images between free-space checks
-
-double free_mb(const fs::path& folder) {
-  struct statvfs s {};
-  if (statvfs(folder.c_str(), &s) != 0) return -1;
-  return double(s.f_bavail) * s.f_frsize / (1024.0 * 1024.0);
-}
 
 #ifdef TEGA_HAVE_OPENCV
 // OpenCV names a mosaic by its second row; GenICam by its first.
@@ -98,11 +91,6 @@ TakeWriter::TakeWriter(fs::path take_folder, std::vector<Camera> cameras, const 
 }
 
 TakeWriter::~TakeWriter() { finish(); }
-
-int TakeWriter::stored_channels(int camera) const {
-  const auto& f = cameras_[camera].format;
-  return options_.debayer && !f.bayer.empty() ? 3 : f.channels;
-}
 
 bool TakeWriter::submit(const FrameSet& set, int index) {
   if (failed_) return false;

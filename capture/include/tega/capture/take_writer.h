@@ -48,8 +48,6 @@ class TakeWriter {
   // Whether the image of (frame index, camera) is on disk; valid after finish().
   bool written(int index, int camera) const;
   std::string extension() const { return extension_; }
-  // The stored image's channels and bit depth for a camera (after debayering).
-  int stored_channels(int camera) const;
 
   // Called before each image is written, with its final path; tests throw
   // from it to inject a write error.
