@@ -83,8 +83,19 @@ if(TEGA_BUILD_AVATAR)
   endif()
 endif()
 
+# Open3D: surface reconstruction and point-cloud tools of mvs/.
+set(TEGA_HAVE_OPEN3D OFF)
+find_package(Open3D QUIET)
+if(Open3D_FOUND)
+  set(TEGA_HAVE_OPEN3D ON)
+else()
+  message(STATUS "tega: Open3D not found (libopen3d-dev): mvs/ builds its depth estimation only")
+endif()
+
+# nvcc compiles the kernels of avatar/ and of mvs/'s depth estimation; no GPU
+# is needed to build them.
 set(TEGA_HAVE_CUDA OFF)
-if(TEGA_BUILD_AVATAR AND TEGA_WITH_CUDA)
+if(TEGA_WITH_CUDA)
   include(CheckLanguage)
   if(NOT CMAKE_CUDA_COMPILER AND EXISTS /usr/local/cuda/bin/nvcc)
     set(CMAKE_CUDA_COMPILER /usr/local/cuda/bin/nvcc)
