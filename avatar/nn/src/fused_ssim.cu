@@ -17,7 +17,7 @@
 #include "fused_ssim_kernels.h"
 #include "ssim_math.h"
 
-#include "tega/avatar/cuda_check.h"
+#include "tega/core/cuda_check.h"
 
 namespace tega::nn::ssim::cuda {
 namespace {

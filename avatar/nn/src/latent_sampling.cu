@@ -24,7 +24,7 @@
 #include <climits>
 #include <stdexcept>
 
-#include "tega/avatar/cuda_check.h"
+#include "tega/core/cuda_check.h"
 #include "latent_sampling_kernels.h"
 #include "latent_sampling_math.h"
 

@@ -7,7 +7,7 @@
 
 #include <cstdint>
 
-#include "tega/avatar/host_device.h"
+#include "tega/core/host_device.h"
 
 namespace tega::nn::latent_sampling {
 

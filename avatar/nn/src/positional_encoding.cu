@@ -12,7 +12,7 @@
 
 #include "positional_encoding_kernels.h"
 #include "positional_encoding_math.h"
-#include "tega/avatar/cuda_check.h"
+#include "tega/core/cuda_check.h"
 
 namespace tega::nn::positional_encoding::cuda {
 namespace {

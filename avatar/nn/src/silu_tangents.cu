@@ -7,7 +7,7 @@
 
 #include <algorithm>
 
-#include "tega/avatar/cuda_check.h"
+#include "tega/core/cuda_check.h"
 #include "silu_tangents_kernels.h"
 #include "silu_tangents_math.h"
 

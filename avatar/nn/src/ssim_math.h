@@ -16,7 +16,7 @@
 //   ∂m/∂μa (at fixed E[a²], E[ab], i.e. through σa² and σab too)
 //             = 2 μb (A2 − A1) / (B1 B2) + 2 μa m (1/B2 − 1/B1).
 
-#include "tega/avatar/host_device.h"
+#include "tega/core/host_device.h"
 
 namespace tega::nn::ssim {
 

@@ -2,7 +2,7 @@
 
 #include "adam_update_kernels.h"
 
-#include "tega/avatar/cuda_check.h"
+#include "tega/core/cuda_check.h"
 
 namespace tega::trainer::adam_update::cuda {
 namespace {

@@ -3,7 +3,7 @@
 
 #include <algorithm>
 
-#include "tega/avatar/cuda_check.h"
+#include "tega/core/cuda_check.h"
 #include "fused_covariance_kernels.h"
 #include "fused_covariance_math.h"
 

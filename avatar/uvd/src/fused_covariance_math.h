@@ -11,7 +11,7 @@
 //   ∂L/∂q = (∂L/∂q̂ − q̂ (q̂·∂L/∂q̂)) / |q|.
 
 #include "scalar_math.h"
-#include "tega/avatar/host_device.h"
+#include "tega/core/host_device.h"
 
 namespace tega::uvd::fused_covariance {
 

@@ -4,7 +4,7 @@
 
 #include <algorithm>
 
-#include "tega/avatar/cuda_check.h"
+#include "tega/core/cuda_check.h"
 #include "fused_uvd_map_kernels.h"
 
 namespace tega::uvd::fused_uvd_map::cuda {

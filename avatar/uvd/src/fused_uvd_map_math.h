@@ -14,7 +14,7 @@
 #include <cstdint>
 
 #include "scalar_math.h"
-#include "tega/avatar/host_device.h"
+#include "tega/core/host_device.h"
 
 namespace tega::uvd::fused_uvd_map {
 

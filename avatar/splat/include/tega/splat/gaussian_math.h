@@ -10,7 +10,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "tega/avatar/host_device.h"
+#include "tega/core/host_device.h"
 
 namespace tega::splat {
 

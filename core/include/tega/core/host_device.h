@@ -1,6 +1,6 @@
 #pragma once
 // Qualifiers of the math shared by the CPU paths and the CUDA kernels of
-// avatar/ (plain C++17 without torch types): nvcc compiles it as
+// avatar/ and mvs/ (plain C++17 without torch types): nvcc compiles it as
 // __host__ __device__, g++ as ordinary inline functions.
 
 #if defined(__CUDACC__)

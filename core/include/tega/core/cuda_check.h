@@ -1,5 +1,5 @@
 #pragma once
-// Error checks shared by the avatar components' CUDA code: a failed call or
+// Error checks shared by the CUDA code of avatar/ and mvs/: a failed call or
 // kernel launch throws, naming the op and what failed.
 
 #include <cuda_runtime_api.h>
