@@ -11,6 +11,7 @@ void add_rig_command(CLI::App& app);
 void add_ingest_command(CLI::App& app);
 void add_capture_command(CLI::App& app);
 void add_calibrate_command(CLI::App& app);
+void add_mvs_command(CLI::App& app);
 void add_train_command(CLI::App& app);
 void add_render_command(CLI::App& app);
 void add_eval_command(CLI::App& app);

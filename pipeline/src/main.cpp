@@ -30,6 +30,9 @@ int main(int argc, char** argv) {
 #ifdef TEGA_HAVE_CALIBRATE
   tega::cli::add_calibrate_command(app);
 #endif
+#ifdef TEGA_HAVE_MVS
+  tega::cli::add_mvs_command(app);
+#endif
 #ifdef TEGA_HAVE_TRAINER
   tega::cli::add_train_command(app);
 #endif

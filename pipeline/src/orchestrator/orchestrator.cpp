@@ -172,8 +172,12 @@ class Run {
     const Stage& stage = stage_of(s);
     const SubjectConfig& subject = config_.subjects[s.subject];
     const fs::path staging = ws_.staging_dir(stage.name(), subject.name);
-    remove_tree(staging);
+    const fs::path resume_key = staging / kResumeKeyFile;
+    const std::string key = s.fingerprint.key();
+    if (!(stage.kind->resumes_in_staging && fs::exists(resume_key) && read_text_file(resume_key) == key))
+      remove_tree(staging);
     fs::create_directories(staging);
+    if (stage.kind->resumes_in_staging) write_text_atomic(resume_key, key);
 
     ShardPaths paths;
     paths.output = staging;
@@ -241,6 +245,7 @@ class Run {
     for (const auto& [artifact, path] : stage.kind->provides) {
       if (!fs::exists(staging / path)) throw Error(staging / path, "was not produced by the shard's command");
     }
+    fs::remove(staging / kResumeKeyFile);
     Manifest m;
     m.stage = stage.name();
     m.shard = subject;

@@ -149,8 +149,22 @@ std::vector<StageKind> make_stage_kinds() {
                       p);
   };
   kinds.push_back(calibrate);
-  kinds.push_back(not_implemented("mvs", "reconstructs a mesh per frame (multi-view stereo)", {"capture", "rig"},
-                                  {{"meshes", "meshes"}}));
+  // Every performance take of the capture, with the calibrated rig.
+  StageKind mvs;
+  mvs.name = "mvs";
+  mvs.summary = "reconstructs a mesh per frame of every performance take (tega mvs)";
+  mvs.subcommand = {"mvs"};
+  mvs.needs = {"capture", "rig"};
+  mvs.provides = {{"meshes", "meshes"}};
+  mvs.options_section = "mvs";
+  mvs.device_option = "device";
+  mvs.resumes_in_staging = true;
+  mvs.arguments = [](const ShardPaths& p) {
+    return with_config({"--capture", p.artifacts.at("capture").string(), "--rig", p.artifacts.at("rig").string(),
+                        "--out", (p.output / "meshes").string()},
+                       p);
+  };
+  kinds.push_back(mvs);
   kinds.push_back(not_implemented("tracking", "fits the blendshape template to the per-frame meshes",
                                   {"meshes", "rig"}, {{"tracked", "tracked"}}));
   kinds.push_back(not_implemented("matting", "mattes and downsamples the images into a dataset",

@@ -15,6 +15,9 @@
 namespace tega::pipeline {
 
 inline constexpr const char* kManifestFile = "manifest.json";
+// In the staging directory of a shard whose kind resumes there: the
+// fingerprint key its partial outputs were made for (removed at commit).
+inline constexpr const char* kResumeKeyFile = ".resume-key";
 
 struct OutputFile {
   std::string path;  // relative to the shard directory, '/'-separated

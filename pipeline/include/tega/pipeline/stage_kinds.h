@@ -43,6 +43,10 @@ struct StageKind {
   bool reads_capture = false;                            // the subject's `capture` is an input
   std::vector<std::string> path_options;                 // options that name external input files
   std::string device_option;                             // option naming the device ("cuda..." = a GPU stage)
+  // The command keeps what it finished in its output and skips it when run
+  // again (e.g. per-frame meshes): a shard interrupted and started again with
+  // the same fingerprint keeps its staging directory instead of starting over.
+  bool resumes_in_staging = false;
   std::function<std::vector<std::string>(const ShardPaths&)> arguments;  // after the subcommand
 };
 

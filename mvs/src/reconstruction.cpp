@@ -1,0 +1,304 @@
+#include "tega/mvs/reconstruction.h"
+
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <optional>
+#include <nlohmann/json.hpp>
+
+#include "tega/core/error.h"
+#include "tega/core/files.h"
+#include "tega/core/log.h"
+#include "tega/core/options.h"
+#include "tega/core/progress.h"
+#include "tega/core/rig.h"
+#include "tega/core/thread_pool.h"
+#include "tega/mvs/colmap_workspace.h"
+#include "tega/mvs/debayer.h"
+#include "tega/mvs/frame_views.h"
+#include "tega/mvs/view_selection.h"
+
+namespace fs = std::filesystem;
+
+namespace tega::mvs {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+std::string frame_name(int frame) {
+  char name[16];
+  std::snprintf(name, sizeof name, "%06d", frame);
+  return name;
+}
+
+bool sees_subject(const StereoView& view, const MaskOptions& options) {
+  if (view.mask.empty()) return true;
+  int64_t inside = 0;
+  for (uint8_t m : view.mask) inside += m != 0;
+  return double(inside) >= options.min_view_share * double(view.mask.size());
+}
+
+std::string camera_list(const std::vector<StereoView>& views, const std::vector<int>& indices) {
+  std::string names;
+  for (int k : indices) names += (names.empty() ? "" : ", ") + views[k].camera.name;
+  return names.empty() ? "none" : names;
+}
+
+}  // namespace
+
+Device resolve_device(const std::string& name) {
+  if (name == "auto") return cuda_device_available() ? Device::cuda : Device::cpu;
+  return parse_device(name);
+}
+
+void parse_frame_range(const std::string& text, int& first, int& end) {
+  const auto number = [&](const std::string& s) {
+    size_t used = 0;
+    int value = -1;
+    try {
+      value = std::stoi(s, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != s.size() || value < 0) throw Error("--frames '" + text + "': expected A:B, A: or A (frame numbers)");
+    return value;
+  };
+  const size_t colon = text.find(':');
+  if (colon == std::string::npos) {
+    first = number(text);
+    end = first + 1;
+    return;
+  }
+  first = number(text.substr(0, colon));
+  end = colon + 1 == text.size() ? -1 : number(text.substr(colon + 1));
+  if (end != -1 && end <= first) throw Error("--frames '" + text + "': the range is empty");
+}
+
+FrameReconstruction reconstruct_views(const std::vector<StereoView>& views, const Options& options, Device device,
+                                      const std::string& label, ThreadPool& pool) {
+  std::vector<int> seeing;
+  for (int k = 0; k < int(views.size()); ++k)
+    if (sees_subject(views[k], options.mask)) seeing.push_back(k);
+  if (int(seeing.size()) < options.min_views)
+    throw Error(label + ": the subject is seen by " + std::to_string(seeing.size()) + " camera(s) (" +
+                camera_list(views, seeing) + "); at least " + std::to_string(options.min_views) + " are needed");
+
+  std::vector<Camera> cameras;
+  for (int k : seeing) cameras.push_back(views[k].camera);
+  std::optional<Eigen::Vector3d> focus;
+  if (options.depth_range_m.empty()) {
+    focus = rig_focus_point(cameras);
+    if (!focus)
+      throw Error(label + ": the cameras do not aim at a common point (" + camera_list(views, seeing) +
+                  "); give depth_range_m");
+  } else if (options.depth_range_m.size() != 2 || !(options.depth_range_m[0] > 0) ||
+             !(options.depth_range_m[1] > options.depth_range_m[0])) {
+    throw Error("mvs: depth_range_m must be [min, max] with 0 < min < max");
+  }
+  const auto ranked = focus ? select_source_views(cameras, *focus, options.patch_match.source_views)
+                            : select_source_views_by_axes(cameras, options.patch_match.source_views);
+
+  FrameReconstruction result;
+  std::vector<ViewTask> tasks;
+  for (size_t k = 0; k < seeing.size(); ++k) {
+    if (ranked[k].empty()) {
+      logging::warn("%s: %s shares no usable baseline with another camera; it gets no depth map", label.c_str(),
+                    cameras[k].name.c_str());
+      continue;
+    }
+    ViewTask task;
+    task.reference = seeing[k];
+    for (int s : ranked[k]) task.sources.push_back(seeing[s]);
+    if (focus) {
+      const double centre = cameras[k].world_to_camera.apply(*focus).z();
+      task.depth_min = float(std::max(centre - options.subject_radius_m, 0.05 * centre));
+      task.depth_max = float(centre + options.subject_radius_m);
+    } else {
+      task.depth_min = float(options.depth_range_m[0]);
+      task.depth_max = float(options.depth_range_m[1]);
+    }
+    result.map_views.push_back(task.reference);
+    result.source_views.push_back(task.sources);
+    tasks.push_back(std::move(task));
+  }
+
+  auto start = Clock::now();
+  result.depth_maps = estimate_depth_maps(views, tasks, options.patch_match, device, &pool);
+  result.timings.depth_s = seconds_since(start);
+
+  start = Clock::now();
+  result.cloud = fuse_depth_maps(views, result.map_views, result.depth_maps, options.fusion, &pool);
+  result.timings.fusion_s = seconds_since(start);
+  if (result.cloud.size() < 100)
+    throw Error(label + ": only " + std::to_string(result.cloud.size()) +
+                " points survived fusion; the views do not agree on a surface (check the rig and the images)");
+
+  start = Clock::now();
+  SurfaceOptions surface = options.surface;
+  if (surface.threads == 0) surface.threads = pool.size();
+  result.mesh = reconstruct_surface(result.cloud, surface);
+  result.timings.surface_s = seconds_since(start);
+  return result;
+}
+
+namespace {
+
+// A COLMAP dense workspace of one frame, staged and renamed into place.
+void write_frame_workspace(const std::vector<StereoView>& views, const FrameReconstruction& r, const fs::path& dir) {
+  DenseWorkspace workspace;
+  for (const auto& view : views) {
+    workspace.rig.cameras.push_back(view.camera);
+    workspace.images[view.camera.name] = view.colour;
+  }
+  for (size_t k = 0; k < r.map_views.size(); ++k) {
+    const std::string& name = views[r.map_views[k]].camera.name;
+    workspace.depth_maps[name] = r.depth_maps[k];
+    for (int s : r.source_views[k]) workspace.source_views[name].push_back(views[s].camera.name);
+  }
+  workspace.fused = r.cloud;
+  StagedDirectory staged(dir, true);
+  write_dense_workspace(workspace, staged.path());
+  staged.commit();
+}
+
+nlohmann::json frame_record(int frame, const std::vector<StereoView>& views, const FrameReconstruction& r,
+                            const std::string& done_key) {
+  nlohmann::json cameras = nlohmann::json::array();
+  int64_t depth_pixels = 0;
+  for (size_t k = 0; k < r.map_views.size(); ++k) {
+    cameras.push_back(views[r.map_views[k]].camera.name);
+    depth_pixels += r.depth_maps[k].valid_pixels();
+  }
+  const auto& t = r.timings;
+  return {{"frame", frame},
+          {"depth_map_cameras", cameras},
+          {"depth_pixels", depth_pixels},
+          {"points", r.cloud.size()},
+          {"vertices", r.mesh.num_vertices()},
+          {"faces", r.mesh.num_faces()},
+          {"seconds", {{"load", t.load_s}, {"depth", t.depth_s}, {"fusion", t.fusion_s}, {"surface", t.surface_s},
+                       {"write", t.write_s}}},
+          {"made_with", done_key}};
+}
+
+bool frame_done(const fs::path& out, int frame, const std::string& done_key) {
+  const fs::path record = out / (frame_name(frame) + ".json");
+  if (!fs::exists(record) || !fs::exists(out / (frame_name(frame) + ".ply"))) return false;
+  try {
+    return nlohmann::json::parse(read_text_file(record)).value("made_with", "") == done_key;
+  } catch (const std::exception&) {
+    return false;  // unreadable: made again
+  }
+}
+
+std::optional<TakeInfo> clean_plate_take(const CaptureInfo& capture) {
+  for (const auto& take : capture.takes)
+    if (take.kind == "clean_plate") return read_take(capture.root / "takes" / take.name);
+  return std::nullopt;
+}
+
+}  // namespace
+
+namespace {
+
+struct TakeJob {
+  const FrameLoader& loader;
+  const std::map<std::string, Image8>& plates;  // camera -> undistorted clean plate
+  fs::path out;
+  int first, end;
+  std::string done_key;  // options and rig: what a finished frame was made with
+};
+
+void reconstruct_frames(const TakeJob& job, const Options& options, MvsSummary& summary, ThreadPool& pool) {
+  const TakeInfo& take = job.loader.take();
+  fs::create_directories(job.out);
+  Progress progress("mvs " + take.name, job.end - job.first, "frames");
+  for (int frame = job.first; frame < job.end; ++frame) {
+    if (frame_done(job.out, frame, job.done_key)) {
+      ++summary.frames_skipped;
+      progress.advance();
+      continue;
+    }
+    const std::string label = "take " + take.name + " frame " + std::to_string(frame);
+    try {
+      auto start = Clock::now();
+      std::vector<StereoView> views = job.loader.load(frame, pool);
+      for (auto& view : views) {
+        const auto plate = job.plates.find(view.camera.name);
+        if (plate != job.plates.end()) view.mask = subject_mask(view.colour, plate->second, options.mask);
+      }
+      const double load_s = seconds_since(start);
+      FrameReconstruction r = reconstruct_views(views, options, summary.device, label, pool);
+      r.timings.load_s = load_s;
+
+      start = Clock::now();
+      if (options.write_workspace) write_frame_workspace(views, r, job.out / "colmap" / frame_name(frame));
+      write_mesh(r.mesh, job.out / (frame_name(frame) + ".ply"));
+      r.timings.write_s = seconds_since(start);
+      // Written last: its presence marks the frame done.
+      write_text_atomic(job.out / (frame_name(frame) + ".json"), frame_record(frame, views, r, job.done_key).dump(2));
+      const auto& t = r.timings;
+      logging::info("%s: %zu depth maps, %d points, %d faces; load %.1f s, depth %.1f s, fusion %.1f s, surface %.1f s",
+                    label.c_str(), r.depth_maps.size(), r.cloud.size(), r.mesh.num_faces(), t.load_s, t.depth_s,
+                    t.fusion_s, t.surface_s);
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      throw Error(message.rfind(label, 0) == 0 ? message : label + ": " + message);
+    }
+    ++summary.frames_done;
+    progress.advance();
+  }
+  progress.finish();
+}
+
+}  // namespace
+
+MvsSummary reconstruct_capture(const MvsRequest& request, const Options& options) {
+  const CaptureInfo capture = read_capture(request.capture);
+  const fs::path rig_file = !request.rig.empty() ? request.rig
+                            : !capture.rig.empty() ? capture.root / capture.rig
+                                                   : capture.root / "rig.json";
+  const Rig rig = read_rig_json(rig_file);
+  std::vector<std::string> takes = request.takes;
+  if (takes.empty())
+    for (const auto& take : capture.takes)
+      if (take.kind == "performance") takes.push_back(take.name);
+  if (takes.empty()) throw Error(request.capture / "capture.json", "lists no performance take to mesh");
+
+  MvsSummary summary;
+  summary.device = resolve_device(options.device);
+  ThreadPool pool(options.threads);
+  std::map<std::string, Image8> plates;
+  if (options.mask.use_clean_plate) {
+    if (auto plate = clean_plate_take(capture)) {
+      const FrameLoader plate_loader(*plate, rig, rig_file.string(), debayer);
+      for (auto& view : plate_loader.load(0, pool)) plates[view.camera.name] = std::move(view.colour);
+    } else {
+      logging::info("mvs: the capture has no clean plate; every pixel is searched");
+    }
+  }
+  const std::string done_key = options_to_yaml(options) + "# rig\n" + read_text_file(rig_file);
+
+  for (const auto& name : takes) {
+    const FrameLoader loader(read_take(capture.root / "takes" / name), rig, rig_file.string(), debayer);
+    const TakeInfo& take = loader.take();
+    if (take.kind != "performance")
+      logging::warn("mvs: take %s is a %s take, not a performance", take.name.c_str(), take.kind.c_str());
+    const int end = request.end_frame < 0 ? take.frames : std::min(request.end_frame, take.frames);
+    if (request.first_frame >= take.frames)
+      throw Error("mvs: take " + take.name + " has frames 0 to " + std::to_string(take.frames - 1) + "; asked for " +
+                  std::to_string(request.first_frame) + " on");
+    logging::info("mvs: take %s, frames %d to %d, %zu cameras, depth on %s", take.name.c_str(), request.first_frame,
+                  end - 1, take.cameras.size(), summary.device == Device::cuda ? "cuda" : "cpu");
+    reconstruct_frames({loader, plates, request.out / take.name, request.first_frame, end, done_key}, options, summary,
+                       pool);
+    ++summary.takes;
+  }
+  return summary;
+}
+
+}  // namespace tega::mvs

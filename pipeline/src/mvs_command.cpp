@@ -1,0 +1,78 @@
+// `tega mvs`: per-frame multi-view stereo meshes of a take (docs/mvs.md).
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "commands.h"
+#include "tega/core/error.h"
+#include "tega/core/options.h"
+#include "tega/mvs/reconstruction.h"
+
+namespace tega::cli {
+
+namespace {
+
+struct MvsArguments {
+  std::string capture, out, rig, frames, config, device;
+  std::vector<std::string> takes, overrides;
+  int threads = -1;
+  bool workspace = false, print_options = false;
+};
+
+// Defaults, then the --config file's `mvs` section, then --set, then the flags given.
+mvs::Options options_of(const MvsArguments& a) {
+  mvs::Options options;
+  if (!a.config.empty()) load_options(options, a.config, "mvs");
+  for (const auto& kv : a.overrides) {
+    const auto eq = kv.find('=');
+    if (eq == std::string::npos) throw Error("--set " + kv + ": expected key=value");
+    set_option(options, kv.substr(0, eq), kv.substr(eq + 1));
+  }
+  if (!a.device.empty()) options.device = a.device;
+  if (a.threads >= 0) options.threads = a.threads;
+  if (a.workspace) options.write_workspace = true;
+  return options;
+}
+
+void print_options(const mvs::Options& options) {
+  std::cout << "mvs:\n";
+  std::istringstream yaml(options_to_yaml(options));
+  for (std::string line; std::getline(yaml, line);) std::cout << "  " << line << "\n";
+}
+
+}  // namespace
+
+void add_mvs_command(CLI::App& app) {
+  auto args = std::make_shared<MvsArguments>();
+  auto* cmd = app.add_subcommand(
+      "mvs",
+      "Multi-view stereo: a mesh per frame of a capture's performance takes (PatchMatch depth maps, fusion, "
+      "screened Poisson), written as MESHES/<take>/<frame>.ply in metres, world space (docs/mvs.md).");
+  cmd->add_option("--capture", args->capture, "The capture: CAPTURE/ with capture.json, rig.json and takes/.");
+  cmd->add_option("--take", args->takes, "A take to mesh (repeatable; default: every performance take).");
+  cmd->add_option("--out", args->out, "MESHES/: <take>/<frame>.ply and <take>/<frame>.json per frame.");
+  cmd->add_option("--rig", args->rig, "Rig file (default: the capture's rig.json).");
+  cmd->add_option("--frames", args->frames, "Frames A:B (B exclusive), A: or A (default: all).");
+  cmd->add_option("--device", args->device, "cpu, cuda or auto (default auto: cuda when a GPU is available).");
+  cmd->add_option("--threads", args->threads, "CPU worker threads (default: all).");
+  cmd->add_flag("--workspace", args->workspace, "Also write each frame's COLMAP dense workspace (MESHES/colmap/<frame>/).");
+  cmd->add_option("--config", args->config, "YAML file whose `mvs` section sets options (see --print-options).");
+  cmd->add_option("--set", args->overrides, "Override one option, e.g. --set patch_match.iterations=6 (repeatable).");
+  cmd->add_flag("--print-options", args->print_options, "Print every mvs option with its default and exit.");
+  cmd->callback([args] {
+    const mvs::Options options = options_of(*args);
+    if (args->print_options) return print_options(options);
+    if (args->capture.empty() || args->out.empty()) throw Error("tega mvs: --capture and --out are required");
+    mvs::MvsRequest request;
+    request.capture = args->capture;
+    request.takes = args->takes;
+    request.out = args->out;
+    request.rig = args->rig;
+    if (!args->frames.empty()) mvs::parse_frame_range(args->frames, request.first_frame, request.end_frame);
+    const auto summary = mvs::reconstruct_capture(request, options);
+    std::printf("%s: %d take(s), %d frame(s) meshed, %d already done\n", args->out.c_str(), summary.takes,
+                summary.frames_done, summary.frames_skipped);
+  });
+}
+
+}  // namespace tega::cli
