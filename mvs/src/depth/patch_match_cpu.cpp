@@ -24,7 +24,8 @@ class CpuBackend final : public PatchMatchBackend {
     for (int s : task.sources) {
       SourceView source = source_geometry(view.camera, views_[s].camera);
       source.image = grey_image(views_[s]);
-      if (params.geometric) source.depth = previous[s].depth.data();
+      // A source without an estimate adds the same penalty to every hypothesis.
+      if (params.geometric && !previous[s].depth.empty()) source.depth = previous[s].depth.data();
       sources.push_back(source);
     }
     const int width = ref.image.width, height = ref.image.height;

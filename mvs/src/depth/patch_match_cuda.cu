@@ -86,7 +86,7 @@ class CudaBackend final : public PatchMatchBackend {
       const int s = task.sources[k];
       sources.view[k] = source_geometry(view.camera, views_[s].camera);
       sources.view[k].image = {images_[s].data, views_[s].camera.width, views_[s].camera.height};
-      if (params.geometric) {
+      if (params.geometric && !previous[s].depth.empty()) {
         source_depths.emplace_back(previous[s].depth.size());
         source_depths.back().upload(previous[s].depth.data());
         sources.view[k].depth = source_depths.back().data;

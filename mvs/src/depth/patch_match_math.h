@@ -30,7 +30,7 @@ struct SourceView {
   GreyImage image;
   float K[9];             // intrinsics, row-major
   float R[9], t[3];       // reference camera frame -> source camera frame
-  // Geometric pass: the source's depth map and what maps its pixels back.
+  // Geometric pass: the source's depth map (nullptr: none) and what maps its pixels back.
   const float* depth = nullptr;
   float K_inverse[9];
   float R_back[9], t_back[3];  // source camera frame -> reference camera frame
@@ -266,6 +266,7 @@ TEGA_HD float photometric_cost(const SourceView& s, const ReferenceWindow& w, co
 // map, in reference pixels, clipped at the maximum.
 TEGA_HD float reprojection_error(const SourceView& s, const ReferenceView& ref, const Parameters& p, int x, int y,
                                  const float* point) {
+  if (!s.depth) return p.geometric_max_error;
   float ps[3];
   {
     float q[3];

@@ -1,0 +1,108 @@
+// Fusion of exact depth maps of a sphere: every point on the sphere, outliers
+// that no other view confirms dropped.
+#include <gtest/gtest.h>
+
+#include "tega/mvs/fusion.h"
+
+namespace tega::mvs {
+namespace {
+
+constexpr double kRadius = 0.1;
+
+// A camera at distance 0.6 from the origin, looking at it, from azimuth `angle`.
+Camera looking_at_origin(const std::string& name, double angle_deg) {
+  Camera c;
+  c.name = name;
+  c.width = 96;
+  c.height = 80;
+  c.K << 300, 0, 47.5, 0, 300, 39.5, 0, 0, 1;
+  const double a = angle_deg * M_PI / 180;
+  const Eigen::Vector3d centre(0.6 * std::sin(a), 0.05, -0.6 * std::cos(a));
+  const Eigen::Vector3d z = (-centre).normalized(), x = Eigen::Vector3d::UnitY().cross(z).normalized(), y = z.cross(x);
+  c.world_to_camera.R.row(0) = x;
+  c.world_to_camera.R.row(1) = y;
+  c.world_to_camera.R.row(2) = z;
+  c.world_to_camera.t = -c.world_to_camera.R * centre;
+  return c;
+}
+
+// The exact depth and normal of the sphere at every pixel.
+DepthMap sphere_depth(const Camera& c) {
+  DepthMap map(c.width, c.height);
+  const Eigen::Vector3d o = c.world_to_camera.t;  // the sphere's centre in camera coordinates
+  for (int y = 0; y < c.height; ++y)
+    for (int x = 0; x < c.width; ++x) {
+      const Eigen::Vector3d ray = c.K.inverse() * Eigen::Vector3d(x, y, 1);  // z = 1
+      const double a = ray.squaredNorm(), b = -2 * ray.dot(o), cc = o.squaredNorm() - kRadius * kRadius;
+      const double disc = b * b - 4 * a * cc;
+      if (disc < 0) continue;
+      const double depth = (-b - std::sqrt(disc)) / (2 * a);
+      const Eigen::Vector3d normal = (depth * ray - o).normalized();
+      const size_t i = map.index(x, y);
+      map.depth[i] = float(depth);
+      for (int k = 0; k < 3; ++k) map.normals[3 * i + k] = float(normal(k));
+      map.cost[i] = 0;
+    }
+  return map;
+}
+
+struct Scene {
+  std::vector<StereoView> views;
+  std::vector<DepthMap> maps;
+  std::vector<int> map_views;
+};
+
+Scene sphere_scene() {
+  Scene s;
+  for (int k = 0; k < 5; ++k) {
+    StereoView view;
+    view.camera = looking_at_origin("cam" + std::to_string(k), -30 + 15 * k);
+    view.grey = ImageF(view.camera.width, view.camera.height, 1, 0.5f);
+    s.maps.push_back(sphere_depth(view.camera));
+    s.views.push_back(std::move(view));
+    s.map_views.push_back(k);
+  }
+  return s;
+}
+
+TEST(Fusion, PointsLieOnTheSurfaceWithOutwardNormals) {
+  const Scene s = sphere_scene();
+  FusionOptions o;
+  o.voxel_size_m = 0;
+  const OrientedPointCloud cloud = fuse_depth_maps(s.views, s.map_views, s.maps, o);
+  ASSERT_GT(cloud.size(), 5000);
+  for (int i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3d p = cloud.points.row(i).cast<double>();
+    ASSERT_NEAR(p.norm(), kRadius, 2e-4);
+    ASSERT_GT(cloud.normals.row(i).cast<double>().dot(p.normalized()), 0.99);
+  }
+  EXPECT_EQ(cloud.colors.rows(), cloud.size());
+  EXPECT_EQ(int(cloud.colors(0, 0)), 128);  // grey 0.5
+}
+
+TEST(Fusion, UnconfirmedDepthsAreDropped) {
+  Scene s = sphere_scene();
+  // A patch of view 2 pushed 3 cm back: no other view sees anything there.
+  for (int y = 30; y < 50; ++y)
+    for (int x = 38; x < 58; ++x) s.maps[2].depth[s.maps[2].index(x, y)] += 0.03f;
+  FusionOptions o;
+  o.voxel_size_m = 0;
+  const OrientedPointCloud cloud = fuse_depth_maps(s.views, s.map_views, s.maps, o);
+  for (int i = 0; i < cloud.size(); ++i) ASSERT_NEAR(cloud.points.row(i).cast<double>().norm(), kRadius, 2e-4);
+  o.min_consistent_views = 5;  // more than the other views there are
+  EXPECT_EQ(fuse_depth_maps(s.views, s.map_views, s.maps, o).size(), 0);
+}
+
+TEST(Fusion, VoxelsMergePoints) {
+  const Scene s = sphere_scene();
+  FusionOptions o;
+  o.voxel_size_m = 0;
+  const int all = fuse_depth_maps(s.views, s.map_views, s.maps, o).size();
+  o.voxel_size_m = 0.004;
+  const OrientedPointCloud merged = fuse_depth_maps(s.views, s.map_views, s.maps, o);
+  EXPECT_LT(merged.size(), all / 3);
+  for (int i = 0; i < merged.size(); ++i) ASSERT_NEAR(merged.points.row(i).cast<double>().norm(), kRadius, 1e-3);
+}
+
+}  // namespace
+}  // namespace tega::mvs
