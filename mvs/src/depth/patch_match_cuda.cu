@@ -15,7 +15,8 @@ namespace tega::mvs {
 
 bool cuda_device_available() {
   int count = 0;
-  return cudaGetDeviceCount(&count) == cudaSuccess && count > 0;
+  // cudaFree(nullptr) creates the context: a GPU that cannot run kernels is not available.
+  return cudaGetDeviceCount(&count) == cudaSuccess && count > 0 && cudaFree(nullptr) == cudaSuccess;
 }
 
 namespace detail {

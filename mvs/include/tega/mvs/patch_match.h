@@ -70,7 +70,7 @@ struct ViewTask {
 
 enum class Device { cpu, cuda };
 Device parse_device(const std::string& name);  // "cpu" | "cuda"; throws tega::Error otherwise
-bool cuda_device_available();                  // a CUDA build with a usable GPU
+bool cuda_device_available();                  // a CUDA build with a usable GPU (its context is made here)
 
 // Depth maps of every task's reference view, in task order. `pool` runs the
 // CPU path (nullptr: a pool of its own); `progress`, when given, advances by
