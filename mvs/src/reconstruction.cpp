@@ -13,6 +13,7 @@
 #include "tega/core/progress.h"
 #include "tega/core/rig.h"
 #include "tega/core/thread_pool.h"
+#include "tega/core/undistort.h"
 #include "tega/mvs/colmap_workspace.h"
 #include "tega/mvs/debayer.h"
 #include "tega/mvs/frame_views.h"
@@ -299,6 +300,38 @@ MvsSummary reconstruct_capture(const MvsRequest& request, const Options& options
     ++summary.takes;
   }
   return summary;
+}
+
+FrameTimings reconstruct_photos(const PhotoRequest& request, const Options& options) {
+  const Rig rig = fs::is_directory(request.rig) ? read_colmap_text(request.rig, request.rig_metres_per_unit)
+                                                : read_rig_json(request.rig);
+  ThreadPool pool(options.threads);
+  const auto start = Clock::now();
+  std::vector<StereoView> views(rig.cameras.size());
+  pool.parallel_for(0, int64_t(rig.cameras.size()), [&](int64_t k) {
+    const Camera& camera = rig.cameras[size_t(k)];
+    fs::path file;
+    for (const char* extension : {".png", ".jpg", ".jpeg", ".JPG", ".tif", ".tiff"})
+      if (fs::exists(request.images / (camera.name + extension))) file = request.images / (camera.name + extension);
+    if (file.empty()) throw Error(request.images, "has no image of camera " + camera.name + " (" + camera.name + ".png, .jpg or .tif)");
+    const Image8 image = rgb_of(read_image_u8(file));
+    if (image.width != camera.width || image.height != camera.height)
+      throw Error(file, "is " + std::to_string(image.width) + "x" + std::to_string(image.height) + ", but camera " +
+                            camera.name + " of the rig is " + std::to_string(camera.width) + "x" +
+                            std::to_string(camera.height));
+    StereoView& view = views[size_t(k)];
+    view.camera = without_distortion(camera);
+    view.colour = undistort_image(image, camera);
+    view.grey = grey_of(view.colour);
+  });
+  const double load_s = seconds_since(start);
+  FrameReconstruction r = reconstruct_views(views, options, resolve_device(options.device), request.images.string(), pool);
+  r.timings.load_s = load_s;
+  const auto write_start = Clock::now();
+  if (!request.workspace.empty()) write_frame_workspace(views, r, request.workspace);
+  write_mesh(r.mesh, request.out);
+  r.timings.write_s = seconds_since(write_start);
+  return r.timings;
 }
 
 }  // namespace tega::mvs

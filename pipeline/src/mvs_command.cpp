@@ -13,7 +13,8 @@ namespace tega::cli {
 namespace {
 
 struct MvsArguments {
-  std::string capture, out, rig, frames, config, device;
+  std::string capture, out, rig, frames, config, device, images, workspace_dir;
+  double rig_metres_per_unit = 1.0;
   std::vector<std::string> takes, overrides;
   int threads = -1;
   bool workspace = false, print_options = false;
@@ -40,6 +41,30 @@ void print_options(const mvs::Options& options) {
   for (std::string line; std::getline(yaml, line);) std::cout << "  " << line << "\n";
 }
 
+void add_shared_options(CLI::App& cmd, const std::shared_ptr<MvsArguments>& args) {
+  cmd.add_option("--device", args->device, "cpu, cuda or auto (default auto: cuda when a GPU is available).");
+  cmd.add_option("--threads", args->threads, "CPU worker threads (default: all).");
+  cmd.add_option("--config", args->config, "YAML file whose `mvs` section sets options (see --print-options).");
+  cmd.add_option("--set", args->overrides, "Override one option, e.g. --set patch_match.iterations=6 (repeatable).");
+}
+
+void add_photos_command(CLI::App& mvs_command, const std::shared_ptr<MvsArguments>& args) {
+  auto* cmd = mvs_command.add_subcommand(
+      "photos", "A mesh from an ordinary calibrated photo set: one image per camera of the rig (docs/mvs.md#photo-sets).");
+  cmd->add_option("--images", args->images, "Folder of images named <camera>.png/.jpg/.tif.")->required();
+  cmd->add_option("--rig", args->rig, "rig.json, or a COLMAP text model directory (cameras.txt, images.txt).")->required();
+  cmd->add_option("--rig-metres-per-unit", args->rig_metres_per_unit, "A COLMAP model's unit in metres (default 1).");
+  cmd->add_option("--out", args->out, "The mesh to write (.ply).")->required();
+  cmd->add_option("--workspace", args->workspace_dir, "Also write a COLMAP dense workspace here.");
+  add_shared_options(*cmd, args);
+  cmd->callback([args] {
+    mvs::PhotoRequest request{args->images, args->rig, args->rig_metres_per_unit, args->out, args->workspace_dir};
+    const auto t = mvs::reconstruct_photos(request, options_of(*args));
+    std::printf("%s: load %.1f s, depth %.1f s, fusion %.1f s, surface %.1f s\n", args->out.c_str(), t.load_s, t.depth_s,
+                t.fusion_s, t.surface_s);
+  });
+}
+
 }  // namespace
 
 void add_mvs_command(CLI::App& app) {
@@ -53,13 +78,14 @@ void add_mvs_command(CLI::App& app) {
   cmd->add_option("--out", args->out, "MESHES/: <take>/<frame>.ply and <take>/<frame>.json per frame.");
   cmd->add_option("--rig", args->rig, "Rig file (default: the capture's rig.json).");
   cmd->add_option("--frames", args->frames, "Frames A:B (B exclusive), A: or A (default: all).");
-  cmd->add_option("--device", args->device, "cpu, cuda or auto (default auto: cuda when a GPU is available).");
-  cmd->add_option("--threads", args->threads, "CPU worker threads (default: all).");
-  cmd->add_flag("--workspace", args->workspace, "Also write each frame's COLMAP dense workspace (MESHES/colmap/<frame>/).");
-  cmd->add_option("--config", args->config, "YAML file whose `mvs` section sets options (see --print-options).");
-  cmd->add_option("--set", args->overrides, "Override one option, e.g. --set patch_match.iterations=6 (repeatable).");
+  cmd->add_flag("--workspace", args->workspace,
+                "Also write each frame's COLMAP dense workspace (MESHES/<take>/colmap/<frame>/).");
+  add_shared_options(*cmd, args);
   cmd->add_flag("--print-options", args->print_options, "Print every mvs option with its default and exit.");
-  cmd->callback([args] {
+  cmd->require_subcommand(0, 1);
+  add_photos_command(*cmd, args);
+  cmd->callback([cmd, args] {
+    if (!cmd->get_subcommands().empty()) return;
     const mvs::Options options = options_of(*args);
     if (args->print_options) return print_options(options);
     if (args->capture.empty() || args->out.empty()) throw Error("tega mvs: --capture and --out are required");

@@ -7,21 +7,15 @@
 namespace tega::mvs {
 namespace {
 
-Image8 rgb_of(const Image8& recorded, const TakeInfo& take, const RawToRgb& raw_to_rgb, const std::string& file) {
+Image8 recorded_rgb(const Image8& recorded, const TakeInfo& take, const RawToRgb& raw_to_rgb, const std::string& file) {
   const std::string& format = take.pixel_format;
-  if (format.rfind("RGB", 0) == 0 && recorded.channels >= 3) {
-    if (recorded.channels == 3) return recorded;
-    Image8 rgb(recorded.width, recorded.height, 3);
-    for (size_t i = 0; i < size_t(recorded.width) * recorded.height; ++i)
-      for (int c = 0; c < 3; ++c) rgb.pixels[3 * i + c] = recorded.pixels[recorded.channels * i + c];
-    return rgb;
-  }
+  if (format.rfind("RGB", 0) == 0 && recorded.channels >= 3) return rgb_of(recorded);
   if (format.rfind("BGR", 0) == 0 && recorded.channels == 3) {
     Image8 rgb = recorded;
     for (size_t i = 0; i < rgb.pixels.size(); i += 3) std::swap(rgb.pixels[i], rgb.pixels[i + 2]);
     return rgb;
   }
-  if (format.rfind("Mono", 0) == 0 && recorded.channels == 1) return recorded;
+  if (format.rfind("Mono", 0) == 0 && recorded.channels == 1) return rgb_of(recorded);
   if (format.rfind("Bayer", 0) == 0 && recorded.channels == 1) {
     if (!raw_to_rgb) throw Error(file, "is raw Bayer (" + format + "), which this build cannot debayer (needs OpenCV)");
     return raw_to_rgb(recorded, format);
@@ -31,6 +25,15 @@ Image8 rgb_of(const Image8& recorded, const TakeInfo& take, const RawToRgb& raw_
 }
 
 }  // namespace
+
+Image8 rgb_of(const Image8& image) {
+  if (image.channels == 3) return image;
+  Image8 rgb(image.width, image.height, 3);
+  const bool grey = image.channels < 3;
+  for (size_t i = 0; i < size_t(image.width) * image.height; ++i)
+    for (int c = 0; c < 3; ++c) rgb.pixels[3 * i + c] = image.pixels[image.channels * i + (grey ? 0 : c)];
+  return rgb;
+}
 
 ImageF grey_of(const Image8& image) {
   ImageF grey(image.width, image.height, 1);
@@ -61,7 +64,7 @@ StereoView FrameLoader::load_view(size_t camera, int frame) const {
                           std::to_string(c.height));
   StereoView view;
   view.camera = without_distortion(c);
-  view.colour = undistort_image(rgb_of(recorded, take_, raw_to_rgb_, file.string()), maps_[camera]);
+  view.colour = undistort_image(recorded_rgb(recorded, take_, raw_to_rgb_, file.string()), maps_[camera]);
   view.grey = grey_of(view.colour);
   return view;
 }

@@ -42,6 +42,9 @@ class FrameLoader {
   RawToRgb raw_to_rgb_;
 };
 
+// An 8-bit grey, grey + alpha, RGB or RGBA image as RGB (alpha dropped).
+Image8 rgb_of(const Image8& image);
+
 // Rec. 601 luma of an RGB (or grey) 8-bit image, in [0, 1].
 ImageF grey_of(const Image8& image);
 

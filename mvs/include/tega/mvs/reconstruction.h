@@ -88,6 +88,21 @@ struct MvsSummary {
 // and rig are kept. Errors name the take, the frame, the camera or the file.
 MvsSummary reconstruct_capture(const MvsRequest& request, const Options& options);
 
+// An ordinary calibrated photo set: one image per camera of the rig, named
+// <camera>.<png|jpg|jpeg|tif|tiff> in `images` (COLMAP's image folder with a
+// COLMAP text model as the rig works as it is). No clean plate: every pixel
+// is searched, between the rig's focus point +- subject_radius_m or in
+// depth_range_m. Writes the mesh (PLY) and, when `workspace` is not empty,
+// a COLMAP dense workspace there.
+struct PhotoRequest {
+  std::filesystem::path images;
+  std::filesystem::path rig;        // rig.json, or a COLMAP text model directory (cameras.txt, images.txt)
+  double rig_metres_per_unit = 1.0; // COLMAP models: their unit in metres
+  std::filesystem::path out;        // the mesh, .ply
+  std::filesystem::path workspace;  // optional
+};
+FrameTimings reconstruct_photos(const PhotoRequest& request, const Options& options);
+
 // "A:B" (B exclusive), "A:" or "A" into [first, end). Throws tega::Error.
 void parse_frame_range(const std::string& text, int& first, int& end);
 
