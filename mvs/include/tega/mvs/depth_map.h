@@ -2,6 +2,7 @@
 // A view's depth and normal estimate, as PatchMatch stereo produces it and as
 // COLMAP's dense workspace stores it (stereo/depth_maps, stereo/normal_maps).
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
