@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <map>
 #include <string>
@@ -107,13 +108,57 @@ std::string colmap_camera_line(const Camera& c, size_t id, const std::filesystem
                      rig_text::format_numbers(params));
 }
 
-std::string colmap_image_lines(const Camera& c, size_t id, double metres_per_unit) {
+// Per camera, the points it sees as (pixel, POINT3D_ID), in order of POINT2D_IDX.
+using Observations = std::vector<std::vector<std::pair<Eigen::Vector2d, size_t>>>;
+
+Observations observations_per_camera(const Rig& rig, const std::vector<ColmapPoint>& points,
+                                     const std::filesystem::path& file) {
+  Observations per_camera(rig.cameras.size());
+  for (size_t p = 0; p < points.size(); ++p)
+    for (const auto& [camera, pixel] : points[p].observations) {
+      if (camera < 0 || static_cast<size_t>(camera) >= rig.cameras.size())
+        throw Error(file, fmt::format("point {} is observed by camera index {}, but the rig has {} cameras",
+                                      p + 1, camera, rig.cameras.size()));
+      per_camera[static_cast<size_t>(camera)].emplace_back(pixel, p + 1);
+    }
+  return per_camera;
+}
+
+std::string colmap_image_lines(const Camera& c, size_t id, double metres_per_unit,
+                               std::string_view image_name_suffix,
+                               const std::vector<std::pair<Eigen::Vector2d, size_t>>& observations) {
   Eigen::Quaterniond q(c.world_to_camera.R);
   if (q.w() < 0) q.coeffs() *= -1;  // COLMAP writes the hemisphere with QW >= 0
   const Eigen::Vector3d t = c.world_to_camera.t / metres_per_unit;
-  return fmt::format("{} {} {} {}\n\n", id,
+  std::string points2d;
+  for (const auto& [pixel, point_id] : observations)
+    points2d += fmt::format("{}{} {}", points2d.empty() ? "" : " ",
+                            rig_text::format_numbers({pixel.x() + kColmapPixelOffset,
+                                                      pixel.y() + kColmapPixelOffset}),
+                            point_id);
+  return fmt::format("{} {} {} {}{}\n{}\n", id,
                      rig_text::format_numbers({q.w(), q.x(), q.y(), q.z(), t.x(), t.y(), t.z()}),
-                     id, c.name);
+                     id, c.name, image_name_suffix, points2d);
+}
+
+std::string colmap_points(const std::vector<ColmapPoint>& points, const Observations& per_camera,
+                          double metres_per_unit) {
+  // A point's track lists (IMAGE_ID, POINT2D_IDX): where it sits in each image's POINTS2D.
+  std::vector<std::string> tracks(points.size());
+  for (size_t camera = 0; camera < per_camera.size(); ++camera)
+    for (size_t index = 0; index < per_camera[camera].size(); ++index)
+      tracks[per_camera[camera][index].second - 1] += fmt::format(" {} {}", camera + 1, index);
+  std::string text =
+      "# 3D point list with one line of data per point:\n"
+      "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n"
+      "# Number of points: " + std::to_string(points.size()) + "\n";
+  for (size_t p = 0; p < points.size(); ++p)
+    text += fmt::format("{} {} 0 0 0 0{}\n", p + 1,
+                        rig_text::format_numbers({points[p].position.x() / metres_per_unit,
+                                                  points[p].position.y() / metres_per_unit,
+                                                  points[p].position.z() / metres_per_unit}),
+                        tracks[p]);
+  return text;
 }
 
 }  // namespace
@@ -143,7 +188,7 @@ Rig read_colmap_text(const std::filesystem::path& directory, double metres_per_u
     q.normalize();
 
     Camera camera;
-    camera.name = std::string(words[9]);
+    camera.name = colmap_camera_name(words[9]);
     camera.width = found->second.width;
     camera.height = found->second.height;
     camera.K = found->second.K;
@@ -157,10 +202,13 @@ Rig read_colmap_text(const std::filesystem::path& directory, double metres_per_u
   return rig;
 }
 
-void write_colmap_text(const Rig& rig, const std::filesystem::path& directory,
-                       double metres_per_unit) {
+void write_colmap_text(const Rig& rig, const std::filesystem::path& directory, double metres_per_unit,
+                       std::string_view image_name_suffix, const std::vector<ColmapPoint>& points) {
   check_metres_per_unit(metres_per_unit, directory);
   rig.validate(directory);
+  const Observations per_camera = observations_per_camera(rig, points, directory / "points3D.txt");
+  size_t observation_count = 0;
+  for (const auto& seen : per_camera) observation_count += seen.size();
   std::string cameras =
       "# Camera list with one line of data per camera:\n"
       "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n"
@@ -170,22 +218,32 @@ void write_colmap_text(const Rig& rig, const std::filesystem::path& directory,
       "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n"
       "#   POINTS2D[] as (X, Y, POINT3D_ID)\n"
       "# Number of images: " + std::to_string(rig.cameras.size()) +
-      ", mean observations per image: 0\n";
+      ", mean observations per image: " +
+      rig_text::format_number(static_cast<double>(observation_count) / static_cast<double>(rig.cameras.size())) +
+      "\n";
   for (size_t i = 0; i < rig.cameras.size(); ++i) {
     cameras += colmap_camera_line(rig.cameras[i], i + 1, directory / "cameras.txt");
-    images += colmap_image_lines(rig.cameras[i], i + 1, metres_per_unit);
+    images += colmap_image_lines(rig.cameras[i], i + 1, metres_per_unit, image_name_suffix, per_camera[i]);
   }
-  const std::string points =
-      "# 3D point list with one line of data per point:\n"
-      "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n"
-      "# Number of points: 0, mean track length: 0\n";
 
   std::error_code error;
   std::filesystem::create_directories(directory, error);
   if (error) throw Error(directory, "cannot create the directory: " + error.message());
   write_text_atomic(directory / "cameras.txt", cameras);
   write_text_atomic(directory / "images.txt", images);
-  write_text_atomic(directory / "points3D.txt", points);
+  write_text_atomic(directory / "points3D.txt", colmap_points(points, per_camera, metres_per_unit));
+}
+
+std::string colmap_camera_name(std::string_view image_name) {
+  const size_t dot = image_name.rfind('.');
+  if (dot == std::string_view::npos || dot == 0) return std::string(image_name);
+  std::string extension(image_name.substr(dot + 1));
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  constexpr std::string_view kImageExtensions[] = {"png", "jpg", "jpeg", "tif", "tiff", "exr", "bmp"};
+  if (std::find(std::begin(kImageExtensions), std::end(kImageExtensions), extension) == std::end(kImageExtensions))
+    return std::string(image_name);
+  return std::string(image_name.substr(0, dot));
 }
 
 }  // namespace tega

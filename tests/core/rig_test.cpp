@@ -244,8 +244,9 @@ TEST(RigColmap, ReadsColmapsOwnOutput) {
                    "\n");
   test::write_text(dir / "points3D.txt", "");
   const Rig rig = read_colmap_text(dir.path(), 0.01);
-  ASSERT_EQ(rig.camera_names(), (std::vector<std::string>{"left.png", "right.png"}));
-  const Camera& left = rig.camera("left.png");
+  // COLMAP names images by their files; a camera is the name without its image extension.
+  ASSERT_EQ(rig.camera_names(), (std::vector<std::string>{"left", "right"}));
+  const Camera& left = rig.camera("left");
   EXPECT_EQ(left.width, 640);
   EXPECT_EQ(left.K(0, 0), 500);
   EXPECT_EQ(left.K(1, 1), 500);
@@ -256,10 +257,48 @@ TEST(RigColmap, ReadsColmapsOwnOutput) {
   EXPECT_LT((left.world_to_camera.R.transpose() * Eigen::Vector3d::UnitZ() + Eigen::Vector3d::UnitX())
                 .norm(), 1e-15);
   EXPECT_LT((left.world_to_camera.t - Eigen::Vector3d(0.1, 0.2, -0.3)).norm(), 1e-15);
-  const Camera& right = rig.camera("right.png");
+  const Camera& right = rig.camera("right");
   EXPECT_EQ(right.K(0, 0), 610);
   EXPECT_EQ(right.distortion, (std::array<double, 5>{-0.01, 0.002, 0, 0, 0}));
   EXPECT_LT((right.center() - Eigen::Vector3d(0, 0, -1)).norm(), 1e-15);
+}
+
+TEST(RigColmap, ImageNameSuffixAndSparsePointsForDenseWorkspaces) {
+  test::TempDir dir;
+  const Rig rig = studio_rig();
+  std::vector<ColmapPoint> points(2);
+  points[0].position = Eigen::Vector3d(0.1, 0.2, 0.3);
+  points[0].observations = {{0, Eigen::Vector2d(10, 20)}, {2, Eigen::Vector2d(30.25, 40)}};
+  points[1].position = Eigen::Vector3d(-0.1, 0, 1);
+  points[1].observations = {{2, Eigen::Vector2d(5, 6)}, {1, Eigen::Vector2d(7, 8)}};
+  write_colmap_text(rig, dir / "sparse", 0.001, ".png", points);
+  expect_same_rig(rig, read_colmap_text(dir / "sparse", 0.001), 1e-12);
+
+  const std::vector<std::string> images = lines_of(read_text(dir / "sparse" / "images.txt"));
+  ASSERT_EQ(images.size(), 4u + 2 * 3);
+  EXPECT_EQ(words_of(images[4])[9], "cam00.png");
+  // POINTS2D as (X, Y, POINT3D_ID), pixel centres at +0.5.
+  EXPECT_EQ(images[5], "10.5 20.5 1");
+  EXPECT_EQ(images[7], "7.5 8.5 2");
+  EXPECT_EQ(images[9], "30.75 40.5 1 5.5 6.5 2");
+  // TRACK[] as (IMAGE_ID, POINT2D_IDX) by image, coordinates in COLMAP units.
+  std::vector<std::string> points3d;
+  for (const std::string& line : lines_of(read_text(dir / "sparse" / "points3D.txt")))
+    if (line[0] != '#') points3d.push_back(line);
+  EXPECT_EQ(points3d, (std::vector<std::string>{"1 100 200 300 0 0 0 0 1 0 3 0", "2 -100 0 1000 0 0 0 0 2 0 3 1"}));
+
+  points[1].observations[0].first = 3;
+  EXPECT_CONTAINS(error_of([&] { write_colmap_text(rig, dir / "bad", 1.0, ".png", points); }),
+                  "point 2 is observed by camera index 3, but the rig has 3 cameras");
+}
+
+TEST(RigColmap, CameraNameDropsOnlyImageExtensions) {
+  EXPECT_EQ(colmap_camera_name("cam00.png"), "cam00");
+  EXPECT_EQ(colmap_camera_name("IMG_0001.JPG"), "IMG_0001");
+  EXPECT_EQ(colmap_camera_name("a.b.jpeg"), "a.b");
+  EXPECT_EQ(colmap_camera_name("cam00"), "cam00");
+  EXPECT_EQ(colmap_camera_name("cam.raw"), "cam.raw");
+  EXPECT_EQ(colmap_camera_name(".png"), ".png");
 }
 
 TEST(RigColmap, ErrorsNameFileAndLine) {

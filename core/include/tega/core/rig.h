@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "tega/core/camera.h"
@@ -35,15 +36,28 @@ struct Rig {
 Rig read_rig_json(const std::filesystem::path& file);
 void write_rig_json(const Rig& rig, const std::filesystem::path& file);
 
-// COLMAP text model in `directory` (cameras.txt, images.txt, empty points3D.txt).
+// A point of a COLMAP sparse model. COLMAP's dense tools (stereo_fusion) find
+// the views that overlap from the points they share.
+struct ColmapPoint {
+  Eigen::Vector3d position;                                    // metres
+  std::vector<std::pair<int, Eigen::Vector2d>> observations;  // (camera index in the rig, pixel)
+};
+
+// COLMAP text model in `directory` (cameras.txt, images.txt, points3D.txt).
 // Camera model PINHOLE for no distortion, OPENCV when k3 == 0, FULL_OPENCV
 // otherwise; the reader also takes SIMPLE_PINHOLE, SIMPLE_RADIAL and RADIAL.
-// An image's NAME is the camera's name. `metres_per_unit` converts COLMAP's
-// translations to metres. The writer creates `directory` and replaces each of
-// the three files atomically.
+// An image's NAME is the camera's name followed by `image_name_suffix` (COLMAP
+// names images by their file, e.g. "cam00.png"); the reader names each camera
+// by colmap_camera_name(NAME). `metres_per_unit` converts COLMAP's
+// translations to metres. The reader ignores the sparse points. The writer
+// creates `directory` and replaces each of the three files atomically.
 Rig read_colmap_text(const std::filesystem::path& directory, double metres_per_unit = 1.0);
 void write_colmap_text(const Rig& rig, const std::filesystem::path& directory,
-                       double metres_per_unit = 1.0);
+                       double metres_per_unit = 1.0, std::string_view image_name_suffix = "",
+                       const std::vector<ColmapPoint>& points = {});
+// An image NAME without its image file extension (.png, .jpg, .jpeg, .tif,
+// .tiff, .exr, .bmp, any case): "cam00.png" -> "cam00"; other names unchanged.
+std::string colmap_camera_name(std::string_view image_name);
 
 // Multiface KRT: per camera 9 lines (name; 3 lines of K; 1 line of 5
 // distortion values; 3 lines of [R|t] world->camera, t in millimetres) and a

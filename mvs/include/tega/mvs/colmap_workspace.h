@@ -14,6 +14,23 @@
 //
 // COLMAP's array files are a text header "width&height&channels&" followed by
 // float32 values, channel after channel (planar), each row-major.
+//
+// Pixel positions: COLMAP's MVS (patch_match_stereo, stereo_fusion) puts
+// depth-map pixel (col, row) on the ray through image coordinate (col, row) of
+// its own convention, whose pixel centres sit at +0.5: half a pixel up and
+// left of the pixel's centre. tega's maps hold the ray through the centre.
+// Maps are stored as they are, so the two differ by that half pixel (about
+// 0.5 mm at 2 m from a 1000-pixel focal length), as COLMAP's maps do from its
+// own images.
+//
+// sparse/points3D.txt holds tie points derived from the depth maps (pixels
+// on a coarse grid of each view that other views see at a consistent depth):
+// COLMAP's stereo_fusion only fuses views that share sparse points.
+// read_dense_workspace reads text models only (COLMAP's image_undistorter
+// writes binary ones: `colmap model_converter --output_type TXT`). Views are
+// named by their image file without its extension (colmap_camera_name);
+// depth maps read from COLMAP have cost 0 where they have a depth (COLMAP
+// stores no cost; its geometric maps are already filtered).
 
 #include <filesystem>
 #include <map>
@@ -51,7 +68,9 @@ void write_colmap_array(const std::filesystem::path& file, int width, int height
                         const std::vector<float>& interleaved);  // atomic
 std::vector<float> read_colmap_array(const std::filesystem::path& file, int& width, int& height, int& channels);
 
-// fused.ply: binary little-endian x y z nx ny nz (float) red green blue (uchar), COLMAP's layout.
+// fused.ply: binary little-endian x y z nx ny nz (float) red green blue (uchar),
+// COLMAP's layout (a cloud without colours is written black). The reader
+// takes any binary little-endian PLY whose first element is the vertices.
 void write_point_cloud_ply(const OrientedPointCloud& cloud, const std::filesystem::path& file);  // atomic
 OrientedPointCloud read_point_cloud_ply(const std::filesystem::path& file);
 

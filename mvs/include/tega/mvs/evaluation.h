@@ -22,12 +22,15 @@ struct EvaluationOptions {
   std::vector<double> tolerances_m = {0.001, 0.002, 0.003};
   double sample_spacing_m = 0.0005;  // mean distance between surface samples
   // Accuracy counts only reconstruction samples within this distance of the
-  // truth region's samples (so a reconstructed neck or backdrop beyond the
+  // truth region's faces (so a reconstructed neck or backdrop beyond the
   // region does not count); 0: every sample.
   double accuracy_region_margin_m = 0.01;
 };
 
 // `truth_region_faces`: faces of `truth` in the region of interest (empty: all).
+// Accuracy is NaN when no reconstruction sample counts. Sampling uses fixed
+// seeds: the same meshes give the same scores. Throws tega::Error on an
+// invalid mesh, a region face out of range or a truth without faces.
 SurfaceScores evaluate_surface(const Mesh& reconstruction, const Mesh& truth, const std::vector<int>& truth_region_faces,
                                const EvaluationOptions& options);
 

@@ -1,0 +1,118 @@
+// Open3D stays in this file: its headers are heavy.
+#include "tega/mvs/surface.h"
+
+#include <open3d/geometry/KDTreeFlann.h>
+#include <open3d/geometry/PointCloud.h>
+#include <open3d/geometry/TriangleMesh.h>
+#include <open3d/utility/Logging.h>
+
+#include <algorithm>
+
+#include "tega/core/error.h"
+
+namespace tega::mvs {
+namespace {
+
+open3d::geometry::PointCloud to_open3d(const OrientedPointCloud& cloud) {
+  open3d::geometry::PointCloud out;
+  out.points_.reserve(size_t(cloud.size()));
+  out.normals_.reserve(size_t(cloud.size()));
+  for (int i = 0; i < cloud.size(); ++i) {
+    out.points_.push_back(cloud.points.row(i).transpose().cast<double>());
+    out.normals_.push_back(cloud.normals.row(i).transpose().cast<double>());
+  }
+  return out;
+}
+
+void trim_low_density(open3d::geometry::TriangleMesh& mesh, const std::vector<double>& densities, double quantile) {
+  if (quantile <= 0 || densities.empty()) return;
+  std::vector<double> sorted = densities;
+  const size_t k = std::min(sorted.size() - 1, size_t(quantile * double(sorted.size())));
+  std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(k), sorted.end());
+  const double threshold = sorted[k];
+  std::vector<bool> remove(densities.size());
+  for (size_t i = 0; i < densities.size(); ++i) remove[i] = densities[i] < threshold;
+  mesh.RemoveVerticesByMask(remove);
+}
+
+// A face counts as supported when one of its vertices lies within the
+// distance of a point: faces are far smaller than the distance.
+void trim_far_from_points(open3d::geometry::TriangleMesh& mesh, const open3d::geometry::KDTreeFlann& tree,
+                          double max_distance) {
+  if (max_distance <= 0) return;
+  std::vector<bool> near(mesh.vertices_.size());
+  std::vector<int> index(1);
+  std::vector<double> squared_distance(1);
+  for (size_t v = 0; v < mesh.vertices_.size(); ++v)
+    near[v] = tree.SearchKNN(mesh.vertices_[v], 1, index, squared_distance) == 1 &&
+              squared_distance[0] <= max_distance * max_distance;
+  std::vector<bool> remove(mesh.triangles_.size());
+  for (size_t f = 0; f < mesh.triangles_.size(); ++f) {
+    const Eigen::Vector3i& t = mesh.triangles_[f];
+    remove[f] = !near[size_t(t[0])] && !near[size_t(t[1])] && !near[size_t(t[2])];
+  }
+  mesh.RemoveTrianglesByMask(remove);
+}
+
+void trim_small_components(open3d::geometry::TriangleMesh& mesh, double min_share) {
+  if (min_share <= 0 || mesh.triangles_.empty()) return;
+  const auto [component, faces_per_component, area] = mesh.ClusterConnectedTriangles();
+  const size_t largest = *std::max_element(faces_per_component.begin(), faces_per_component.end());
+  std::vector<bool> remove(component.size());
+  for (size_t f = 0; f < component.size(); ++f)
+    remove[f] = double(faces_per_component[size_t(component[f])]) < min_share * double(largest);
+  mesh.RemoveTrianglesByMask(remove);
+}
+
+// Poisson's winding follows the normals it was given, but its convention is
+// Open3D's; vote with the cloud's normals so that faces wind counter-clockwise
+// seen from outside.
+void orient_like_points(open3d::geometry::TriangleMesh& mesh, const open3d::geometry::PointCloud& points,
+                        const open3d::geometry::KDTreeFlann& tree) {
+  std::vector<int> index(1);
+  std::vector<double> squared_distance(1);
+  double agreement = 0;
+  for (const Eigen::Vector3i& t : mesh.triangles_) {
+    const Eigen::Vector3d& a = mesh.vertices_[size_t(t[0])];
+    const Eigen::Vector3d& b = mesh.vertices_[size_t(t[1])];
+    const Eigen::Vector3d& c = mesh.vertices_[size_t(t[2])];
+    if (tree.SearchKNN(Eigen::Vector3d((a + b + c) / 3), 1, index, squared_distance) != 1) continue;
+    agreement += (b - a).cross(c - a).dot(points.normals_[size_t(index[0])]);
+  }
+  if (agreement < 0)
+    for (Eigen::Vector3i& t : mesh.triangles_) std::swap(t[1], t[2]);
+}
+
+Mesh to_tega(const open3d::geometry::TriangleMesh& mesh) {
+  Mesh out;
+  out.positions.resize(Eigen::Index(mesh.vertices_.size()), 3);
+  for (size_t v = 0; v < mesh.vertices_.size(); ++v)
+    out.positions.row(Eigen::Index(v)) = mesh.vertices_[v].transpose().cast<float>();
+  out.faces.resize(Eigen::Index(mesh.triangles_.size()), 3);
+  for (size_t f = 0; f < mesh.triangles_.size(); ++f) out.faces.row(Eigen::Index(f)) = mesh.triangles_[f].transpose();
+  return out;
+}
+
+}  // namespace
+
+Mesh reconstruct_surface(const OrientedPointCloud& cloud, const SurfaceOptions& options) {
+  if (cloud.size() == 0) throw Error("surface reconstruction: the point cloud is empty");
+  if (cloud.normals.rows() != cloud.points.rows())
+    throw Error("surface reconstruction: the point cloud has no normals (" + std::to_string(cloud.normals.rows()) +
+                " for " + std::to_string(cloud.size()) + " points)");
+  open3d::utility::SetVerbosityLevel(open3d::utility::VerbosityLevel::Warning);
+  const open3d::geometry::PointCloud points = to_open3d(cloud);
+  auto [mesh, densities] = open3d::geometry::TriangleMesh::CreateFromPointCloudPoisson(
+      points, size_t(options.poisson_depth), 0.0f, float(options.poisson_scale), false,
+      options.threads > 0 ? options.threads : -1);
+
+  const open3d::geometry::KDTreeFlann tree(points);
+  trim_low_density(*mesh, densities, options.trim_density_quantile);
+  trim_far_from_points(*mesh, tree, options.trim_distance_m);
+  trim_small_components(*mesh, options.min_component_share);
+  mesh->RemoveUnreferencedVertices();
+  orient_like_points(*mesh, points, tree);
+  return to_tega(*mesh);
+}
+
+}  // namespace tega::mvs

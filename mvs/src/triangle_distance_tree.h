@@ -1,0 +1,41 @@
+#pragma once
+// Exact distance from points to a triangle mesh: a bounding-volume hierarchy
+// over the triangles, searched nearest box first and pruned by the best
+// distance found so far, so the answer is the exact point-to-triangle minimum.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "tega/core/mesh.h"
+
+namespace tega::mvs {
+
+class TriangleDistanceTree {
+ public:
+  // `faces`: the triangles of `mesh` to search (empty: all of them).
+  explicit TriangleDistanceTree(const Mesh& mesh, const std::vector<int>& faces = {});
+  bool empty() const { return triangles_.empty(); }
+  // Infinity when the tree is empty.
+  double distance(const Eigen::Vector3d& point) const;
+
+ private:
+  struct Triangle {
+    Eigen::Vector3d a, b, c;
+  };
+  struct Node {
+    Eigen::Vector3d lower, upper;
+    int first = 0, count = 0;  // a leaf's triangles
+    int left = -1, right = -1;
+  };
+  int build(int first, int count);
+  void search(int node, const Eigen::Vector3d& point, double& best_squared) const;
+
+  std::vector<Triangle> triangles_;
+  std::vector<Node> nodes_;
+};
+
+// The closest point of triangle (a, b, c) to p, exactly (by Voronoi regions).
+Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                          const Eigen::Vector3d& c);
+
+}  // namespace tega::mvs
