@@ -39,7 +39,8 @@ void check_writable(const DenseWorkspace& workspace, const fs::path& directory) 
     if (camera.has_distortion())
       throw Error(directory, "camera '" + camera.name + "' has distortion; a dense workspace holds undistorted views");
   const auto check_camera = [&](const std::string& name, const char* what) {
-    if (!workspace.rig.contains(name)) throw Error(directory, fmt::format("{} of camera '{}', which is not in the rig", what, name));
+    if (!workspace.rig.contains(name))
+      throw Error(directory, fmt::format("{} of camera '{}', which is not in the rig", what, name));
   };
   for (const auto& [name, image] : workspace.images) {
     check_camera(name, "an image");
@@ -97,7 +98,8 @@ std::map<std::string, std::string> image_files(const fs::path& images) {
 
 Image8 to_rgb(const Image8& image, const fs::path& file) {
   if (image.channels == 3) return image;
-  if (image.channels < 1 || image.channels > 4) throw Error(file, fmt::format("{} channels, expected 1 to 4", image.channels));
+  if (image.channels < 1 || image.channels > 4)
+    throw Error(file, fmt::format("{} channels, expected 1 to 4", image.channels));
   Image8 rgb(image.width, image.height, 3);
   const bool grey = image.channels <= 2;  // grey or grey + alpha
   for (int y = 0; y < image.height; ++y)
@@ -110,10 +112,12 @@ DepthMap read_depth_and_normals(const fs::path& depth_file, const fs::path& norm
   int width, height, channels;
   std::vector<float> depth = read_colmap_array(depth_file, width, height, channels);
   if (channels != 1) throw Error(depth_file, fmt::format("a depth map has 1 channel, found {}", channels));
-  if (!fs::exists(normal_file)) throw Error(normal_file, "missing: the depth map " + depth_file.string() + " has no normal map");
+  if (!fs::exists(normal_file))
+    throw Error(normal_file, "missing: the depth map " + depth_file.string() + " has no normal map");
   int normal_width, normal_height, normal_channels;
   std::vector<float> normals = read_colmap_array(normal_file, normal_width, normal_height, normal_channels);
-  if (normal_channels != 3) throw Error(normal_file, fmt::format("a normal map has 3 channels, found {}", normal_channels));
+  if (normal_channels != 3)
+    throw Error(normal_file, fmt::format("a normal map has 3 channels, found {}", normal_channels));
   if (normal_width != width || normal_height != height)
     throw Error(normal_file, fmt::format("size mismatch: the normal map is {}x{}, its depth map {}x{}", normal_width,
                                          normal_height, width, height));
@@ -181,7 +185,8 @@ void write_dense_workspace(const DenseWorkspace& workspace, const fs::path& dire
   check_writable(workspace, directory);
   make_directories(directory / "images");
   make_directories(directory / "stereo");
-  for (const auto& [name, image] : workspace.images) write_image(image, directory / "images" / (name + kImageExtension));
+  for (const auto& [name, image] : workspace.images)
+    write_image(image, directory / "images" / (name + kImageExtension));
   write_colmap_text(workspace.rig, directory / "sparse", 1.0, kImageExtension,
                     tie_points_from_depth_maps(workspace.rig, workspace.depth_maps));
   for (const auto& [name, map] : workspace.depth_maps) {

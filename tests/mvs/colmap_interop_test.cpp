@@ -29,8 +29,8 @@ std::optional<fs::path> colmap_executable() {
   return std::nullopt;
 }
 
-#define TEGA_REQUIRE_COLMAP(var)                                          \
-  const std::optional<fs::path> var = colmap_executable();               \
+#define TEGA_REQUIRE_COLMAP(var)                           \
+  const std::optional<fs::path> var = colmap_executable(); \
   if (!var) GTEST_SKIP() << "colmap (COLMAP 3.8) is not on PATH"
 
 // Runs colmap headless; fails the test with its output when it fails.
@@ -84,10 +84,11 @@ TEST(ColmapInterop, PoissonMesherMeshesTegasFusedCloud) {
   write_point_cloud_ply(test::sphere_cloud(20000, kRadius), dir / "fused.ply");
   // Depth 7 (~2 mm cells) keeps the run short; COLMAP's default trim (10)
   // would cut every vertex at that depth, whose densities are about 6.
-  run_colmap(*colmap,
-             "poisson_mesher --PoissonMeshing.depth 7 --PoissonMeshing.trim 0 --input_path '" +
-                 (dir / "fused.ply").string() + "' --output_path '" + (dir / "meshed-poisson.ply").string() + "'",
-             dir / "poisson.log");
+  run_colmap(
+      *colmap,
+      "poisson_mesher --PoissonMeshing.depth 7 --PoissonMeshing.trim 0 --PoissonMeshing.num_threads 1 --input_path '" +
+          (dir / "fused.ply").string() + "' --output_path '" + (dir / "meshed-poisson.ply").string() + "'",
+      dir / "poisson.log");
   const Mesh mesh = read_ply(dir / "meshed-poisson.ply");
   ASSERT_GT(mesh.num_faces(), 5000);
   double worst = 0;
