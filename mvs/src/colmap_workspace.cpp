@@ -3,6 +3,7 @@
 #include <spdlog/fmt/fmt.h>
 
 #include <algorithm>
+#include <string_view>
 
 #include "colmap_tie_points.h"
 #include "tega/core/error.h"
@@ -58,7 +59,9 @@ void check_writable(const DenseWorkspace& workspace, const fs::path& directory) 
   }
   for (const auto& [name, sources] : workspace.source_views) {
     check_camera(name, "source views");
-    for (const std::string& source : sources) check_camera(source, "a source view");
+    for (const std::string& source : sources)
+      if (!workspace.rig.contains(source))
+        throw Error(directory, "source view '" + source + "' of camera '" + name + "' is not in the rig");
   }
 }
 
@@ -133,26 +136,25 @@ DepthMap read_depth_and_normals(const fs::path& depth_file, const fs::path& norm
   return map;
 }
 
-std::vector<std::string> config_lines(const fs::path& file) {
-  std::vector<std::string> lines;
-  std::string text = read_text_file(file);
+// The non-empty pieces of `text` between separators, without surrounding blanks.
+std::vector<std::string> split_trimmed(std::string_view text, char separator) {
+  std::vector<std::string> pieces;
   size_t start = 0;
   while (start <= text.size()) {
-    size_t end = text.find('\n', start);
-    if (end == std::string::npos) end = text.size();
-    std::string line = text.substr(start, end - start);
-    line.erase(0, line.find_first_not_of(" \t\r"));
-    line.erase(line.find_last_not_of(" \t\r") + 1);
-    if (!line.empty()) lines.push_back(line);
+    const size_t end = std::min(text.find(separator, start), text.size());
+    std::string_view piece = text.substr(start, end - start);
+    const size_t first = piece.find_first_not_of(" \t\r");
+    if (first != std::string_view::npos)
+      pieces.emplace_back(piece.substr(first, piece.find_last_not_of(" \t\r") - first + 1));
     start = end + 1;
   }
-  return lines;
+  return pieces;
 }
 
 // patch-match.cfg: pairs of lines, an image then its source images separated
 // by commas, or COLMAP's automatic choices (__auto__, __all__), which name none.
 std::map<std::string, std::vector<std::string>> read_patch_match_config(const fs::path& file, const Rig& rig) {
-  const std::vector<std::string> lines = config_lines(file);
+  const std::vector<std::string> lines = split_trimmed(read_text_file(file), '\n');
   if (lines.size() % 2 != 0) throw Error(file, "expected pairs of lines (an image, then its source images)");
   std::map<std::string, std::vector<std::string>> sources;
   const auto camera_of = [&](const std::string& image) {
@@ -164,16 +166,7 @@ std::map<std::string, std::vector<std::string>> read_patch_match_config(const fs
     const std::string reference = camera_of(lines[i]);
     if (lines[i + 1].starts_with("__")) continue;
     std::vector<std::string>& list = sources[reference];
-    size_t start = 0;
-    while (start <= lines[i + 1].size()) {
-      size_t end = lines[i + 1].find(',', start);
-      if (end == std::string::npos) end = lines[i + 1].size();
-      std::string source = lines[i + 1].substr(start, end - start);
-      source.erase(0, source.find_first_not_of(" \t"));
-      source.erase(source.find_last_not_of(" \t") + 1);
-      if (!source.empty()) list.push_back(camera_of(source));
-      start = end + 1;
-    }
+    for (const std::string& source : split_trimmed(lines[i + 1], ',')) list.push_back(camera_of(source));
   }
   return sources;
 }

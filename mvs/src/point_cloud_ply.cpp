@@ -5,7 +5,6 @@
 #include <spdlog/fmt/fmt.h>
 
 #include <cstring>
-#include <optional>
 #include <sstream>
 
 #include "binary_file.h"

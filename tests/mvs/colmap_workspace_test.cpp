@@ -244,7 +244,7 @@ TEST(DenseWorkspace, RefusesWhatItCannotWrite) {
   DenseWorkspace workspace = sphere_workspace();
   workspace.source_views["cam01"] = {"cam09"};
   EXPECT_CONTAINS(error_of([&] { write_dense_workspace(workspace, dir / "ws"); }),
-                  "a source view of camera 'cam09', which is not in the rig");
+                  "source view 'cam09' of camera 'cam01' is not in the rig");
   workspace = sphere_workspace();
   workspace.rig.cameras[1].distortion[0] = 0.1;
   EXPECT_CONTAINS(error_of([&] { write_dense_workspace(workspace, dir / "ws"); }), "camera 'cam01' has distortion");
