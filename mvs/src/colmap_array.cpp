@@ -22,8 +22,9 @@ int header_field(const std::string& bytes, size_t& position, const char* what, c
   const auto [parsed_to, error] = std::from_chars(first, last, value);
   if (end == std::string::npos || end - position > kMaxDigits || error != std::errc() || parsed_to != last ||
       value <= 0)
-    throw Error(file, fmt::format("bad header: expected \"width&height&channels&\" with positive integers, "
-                                  "the {} is not one", what));
+    throw Error(file, fmt::format("bad header: expected \"width&height&channels&\", and the {} is not a positive "
+                                  "integer followed by '&'",
+                                  what));
   position = end + 1;
   return value;
 }
@@ -36,8 +37,8 @@ void write_colmap_array(const std::filesystem::path& file, int width, int height
     throw Error(file, fmt::format("cannot write a {}x{}x{} array", width, height, channels));
   const size_t pixels = size_t(width) * size_t(height);
   if (interleaved.size() != pixels * size_t(channels))
-    throw Error(file, fmt::format("size mismatch: a {}x{}x{} array holds {} values, given {}", width, height,
-                                  channels, pixels * size_t(channels), interleaved.size()));
+    throw Error(file, fmt::format("size mismatch: a {}x{}x{} array holds {} values, given {}", width, height, channels,
+                                  pixels * size_t(channels), interleaved.size()));
   std::vector<float> planar(interleaved.size());
   for (size_t p = 0; p < pixels; ++p)
     for (size_t c = 0; c < size_t(channels); ++c) planar[c * pixels + p] = interleaved[p * size_t(channels) + c];
@@ -61,8 +62,8 @@ std::vector<float> read_colmap_array(const std::filesystem::path& file, int& wid
   const size_t pixels = size_t(width) * size_t(height);
   const size_t expected = pixels * size_t(channels) * sizeof(float);
   if (found > expected)
-    throw Error(file, fmt::format("size mismatch: a {}x{}x{} array needs {} bytes after the header, found {}",
-                                  width, height, channels, expected, found));
+    throw Error(file, fmt::format("size mismatch: a {}x{}x{} array needs {} bytes after the header, found {}", width,
+                                  height, channels, expected, found));
   std::vector<float> planar(pixels * size_t(channels));
   std::memcpy(planar.data(), bytes.data() + position, expected);
   std::vector<float> interleaved(planar.size());

@@ -21,7 +21,9 @@ struct View {
   const DepthMap* depth;
   double scale_x, scale_y;  // depth map pixels per camera pixel
 
-  Eigen::Vector2d camera_pixel(double x, double y) const { return {(x + 0.5) / scale_x - 0.5, (y + 0.5) / scale_y - 0.5}; }
+  Eigen::Vector2d camera_pixel(double x, double y) const {
+    return {(x + 0.5) / scale_x - 0.5, (y + 0.5) / scale_y - 0.5};
+  }
   Eigen::Vector2d depth_pixel(const Eigen::Vector2d& p) const {
     return {(p.x() + 0.5) * scale_x - 0.5, (p.y() + 0.5) * scale_y - 0.5};
   }

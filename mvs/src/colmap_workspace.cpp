@@ -3,6 +3,7 @@
 #include <spdlog/fmt/fmt.h>
 
 #include <algorithm>
+#include <string_view>
 
 #include "colmap_tie_points.h"
 #include "tega/core/error.h"
@@ -39,7 +40,8 @@ void check_writable(const DenseWorkspace& workspace, const fs::path& directory) 
     if (camera.has_distortion())
       throw Error(directory, "camera '" + camera.name + "' has distortion; a dense workspace holds undistorted views");
   const auto check_camera = [&](const std::string& name, const char* what) {
-    if (!workspace.rig.contains(name)) throw Error(directory, fmt::format("{} of camera '{}', which is not in the rig", what, name));
+    if (!workspace.rig.contains(name))
+      throw Error(directory, fmt::format("{} of camera '{}', which is not in the rig", what, name));
   };
   for (const auto& [name, image] : workspace.images) {
     check_camera(name, "an image");
@@ -57,7 +59,9 @@ void check_writable(const DenseWorkspace& workspace, const fs::path& directory) 
   }
   for (const auto& [name, sources] : workspace.source_views) {
     check_camera(name, "source views");
-    for (const std::string& source : sources) check_camera(source, "a source view");
+    for (const std::string& source : sources)
+      if (!workspace.rig.contains(source))
+        throw Error(directory, "source view '" + source + "' of camera '" + name + "' is not in the rig");
   }
 }
 
@@ -97,7 +101,8 @@ std::map<std::string, std::string> image_files(const fs::path& images) {
 
 Image8 to_rgb(const Image8& image, const fs::path& file) {
   if (image.channels == 3) return image;
-  if (image.channels < 1 || image.channels > 4) throw Error(file, fmt::format("{} channels, expected 1 to 4", image.channels));
+  if (image.channels < 1 || image.channels > 4)
+    throw Error(file, fmt::format("{} channels, expected 1 to 4", image.channels));
   Image8 rgb(image.width, image.height, 3);
   const bool grey = image.channels <= 2;  // grey or grey + alpha
   for (int y = 0; y < image.height; ++y)
@@ -110,10 +115,12 @@ DepthMap read_depth_and_normals(const fs::path& depth_file, const fs::path& norm
   int width, height, channels;
   std::vector<float> depth = read_colmap_array(depth_file, width, height, channels);
   if (channels != 1) throw Error(depth_file, fmt::format("a depth map has 1 channel, found {}", channels));
-  if (!fs::exists(normal_file)) throw Error(normal_file, "missing: the depth map " + depth_file.string() + " has no normal map");
+  if (!fs::exists(normal_file))
+    throw Error(normal_file, "missing: the depth map " + depth_file.string() + " has no normal map");
   int normal_width, normal_height, normal_channels;
   std::vector<float> normals = read_colmap_array(normal_file, normal_width, normal_height, normal_channels);
-  if (normal_channels != 3) throw Error(normal_file, fmt::format("a normal map has 3 channels, found {}", normal_channels));
+  if (normal_channels != 3)
+    throw Error(normal_file, fmt::format("a normal map has 3 channels, found {}", normal_channels));
   if (normal_width != width || normal_height != height)
     throw Error(normal_file, fmt::format("size mismatch: the normal map is {}x{}, its depth map {}x{}", normal_width,
                                          normal_height, width, height));
@@ -129,26 +136,25 @@ DepthMap read_depth_and_normals(const fs::path& depth_file, const fs::path& norm
   return map;
 }
 
-std::vector<std::string> config_lines(const fs::path& file) {
-  std::vector<std::string> lines;
-  std::string text = read_text_file(file);
+// The non-empty pieces of `text` between separators, without surrounding blanks.
+std::vector<std::string> split_trimmed(std::string_view text, char separator) {
+  std::vector<std::string> pieces;
   size_t start = 0;
   while (start <= text.size()) {
-    size_t end = text.find('\n', start);
-    if (end == std::string::npos) end = text.size();
-    std::string line = text.substr(start, end - start);
-    line.erase(0, line.find_first_not_of(" \t\r"));
-    line.erase(line.find_last_not_of(" \t\r") + 1);
-    if (!line.empty()) lines.push_back(line);
+    const size_t end = std::min(text.find(separator, start), text.size());
+    std::string_view piece = text.substr(start, end - start);
+    const size_t first = piece.find_first_not_of(" \t\r");
+    if (first != std::string_view::npos)
+      pieces.emplace_back(piece.substr(first, piece.find_last_not_of(" \t\r") - first + 1));
     start = end + 1;
   }
-  return lines;
+  return pieces;
 }
 
 // patch-match.cfg: pairs of lines, an image then its source images separated
 // by commas, or COLMAP's automatic choices (__auto__, __all__), which name none.
 std::map<std::string, std::vector<std::string>> read_patch_match_config(const fs::path& file, const Rig& rig) {
-  const std::vector<std::string> lines = config_lines(file);
+  const std::vector<std::string> lines = split_trimmed(read_text_file(file), '\n');
   if (lines.size() % 2 != 0) throw Error(file, "expected pairs of lines (an image, then its source images)");
   std::map<std::string, std::vector<std::string>> sources;
   const auto camera_of = [&](const std::string& image) {
@@ -160,16 +166,7 @@ std::map<std::string, std::vector<std::string>> read_patch_match_config(const fs
     const std::string reference = camera_of(lines[i]);
     if (lines[i + 1].starts_with("__")) continue;
     std::vector<std::string>& list = sources[reference];
-    size_t start = 0;
-    while (start <= lines[i + 1].size()) {
-      size_t end = lines[i + 1].find(',', start);
-      if (end == std::string::npos) end = lines[i + 1].size();
-      std::string source = lines[i + 1].substr(start, end - start);
-      source.erase(0, source.find_first_not_of(" \t"));
-      source.erase(source.find_last_not_of(" \t") + 1);
-      if (!source.empty()) list.push_back(camera_of(source));
-      start = end + 1;
-    }
+    for (const std::string& source : split_trimmed(lines[i + 1], ',')) list.push_back(camera_of(source));
   }
   return sources;
 }
@@ -181,7 +178,8 @@ void write_dense_workspace(const DenseWorkspace& workspace, const fs::path& dire
   check_writable(workspace, directory);
   make_directories(directory / "images");
   make_directories(directory / "stereo");
-  for (const auto& [name, image] : workspace.images) write_image(image, directory / "images" / (name + kImageExtension));
+  for (const auto& [name, image] : workspace.images)
+    write_image(image, directory / "images" / (name + kImageExtension));
   write_colmap_text(workspace.rig, directory / "sparse", 1.0, kImageExtension,
                     tie_points_from_depth_maps(workspace.rig, workspace.depth_maps));
   for (const auto& [name, map] : workspace.depth_maps) {

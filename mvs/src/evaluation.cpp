@@ -38,8 +38,8 @@ std::vector<double> distances_to_mesh(const Vertices& points, const Mesh& mesh) 
   return distances(points, TriangleDistanceTree(mesh));
 }
 
-SurfaceScores evaluate_surface(const Mesh& reconstruction, const Mesh& truth, const std::vector<int>& truth_region_faces,
-                               const EvaluationOptions& options) {
+SurfaceScores evaluate_surface(const Mesh& reconstruction, const Mesh& truth,
+                               const std::vector<int>& truth_region_faces, const EvaluationOptions& options) {
   reconstruction.validate("the reconstruction");
   truth.validate("the ground truth");
   if (!(options.sample_spacing_m > 0))
@@ -47,8 +47,8 @@ SurfaceScores evaluate_surface(const Mesh& reconstruction, const Mesh& truth, co
   if (truth.num_faces() == 0) throw Error("evaluation: the ground-truth mesh has no faces");
   for (const int f : truth_region_faces)
     if (f < 0 || f >= truth.num_faces())
-      throw Error(fmt::format("evaluation: region face {} is not a face of the ground truth ({} faces)", f,
-                              truth.num_faces()));
+      throw Error(
+          fmt::format("evaluation: region face {} is not a face of the ground truth ({} faces)", f, truth.num_faces()));
 
   SurfaceScores scores;
   scores.tolerances_m = options.tolerances_m;
@@ -76,7 +76,8 @@ SurfaceScores evaluate_surface(const Mesh& reconstruction, const Mesh& truth, co
   }
   scores.reconstruction_samples = int(accuracy.size());
   if (accuracy.empty()) {
-    scores.accuracy_median_m = scores.accuracy_mean_m = scores.accuracy_p90_m = std::numeric_limits<double>::quiet_NaN();
+    scores.accuracy_median_m = scores.accuracy_mean_m = scores.accuracy_p90_m =
+        std::numeric_limits<double>::quiet_NaN();
     return scores;
   }
   scores.accuracy_median_m = quantile(accuracy, 0.5);

@@ -5,7 +5,6 @@
 #include <spdlog/fmt/fmt.h>
 
 #include <cstring>
-#include <optional>
 #include <sstream>
 
 #include "binary_file.h"
@@ -23,8 +22,7 @@ struct Property {
 size_t type_size(const std::string& type) {
   if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
   if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
-  if (type == "int" || type == "uint" || type == "float" || type == "int32" || type == "uint32" ||
-      type == "float32")
+  if (type == "int" || type == "uint" || type == "float" || type == "int32" || type == "uint32" || type == "float32")
     return 4;
   if (type == "double" || type == "float64") return 8;
   return 0;
@@ -76,8 +74,8 @@ VertexLayout parse_header(const std::string& bytes, const std::filesystem::path&
       words >> property.type >> property.name;
       const size_t size = type_size(property.type);
       if (size == 0)
-        throw Error(file, "bad header: vertex property '" + property.name + "' has unsupported type '" +
-                              property.type + "'");
+        throw Error(file,
+                    "bad header: vertex property '" + property.name + "' has unsupported type '" + property.type + "'");
       property.offset = layout.stride;
       layout.stride += size;
       layout.properties.push_back(property);
@@ -125,8 +123,7 @@ void write_point_cloud_ply(const OrientedPointCloud& cloud, const std::filesyste
     std::memcpy(record + 3 * sizeof(float), cloud.normals.row(Eigen::Index(i)).data(), 3 * sizeof(float));
     // COLMAP's tools expect colours; a cloud without them is written black.
     const uint8_t black[3] = {0, 0, 0};
-    std::memcpy(record + 6 * sizeof(float), cloud.colors.rows() ? cloud.colors.row(Eigen::Index(i)).data() : black,
-                3);
+    std::memcpy(record + 6 * sizeof(float), cloud.colors.rows() ? cloud.colors.row(Eigen::Index(i)).data() : black, 3);
   }
   write_binary_file_atomic(file, bytes);
 }

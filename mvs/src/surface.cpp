@@ -100,6 +100,7 @@ Mesh reconstruct_surface(const OrientedPointCloud& cloud, const SurfaceOptions& 
   if (cloud.normals.rows() != cloud.points.rows())
     throw Error("surface reconstruction: the point cloud has no normals (" + std::to_string(cloud.normals.rows()) +
                 " for " + std::to_string(cloud.size()) + " points)");
+  // Open3D's Poisson prints its progress at Info level, on stdout.
   open3d::utility::SetVerbosityLevel(open3d::utility::VerbosityLevel::Warning);
   const open3d::geometry::PointCloud points = to_open3d(cloud);
   auto [mesh, densities] = open3d::geometry::TriangleMesh::CreateFromPointCloudPoisson(

@@ -29,8 +29,8 @@ std::optional<fs::path> colmap_executable() {
   return std::nullopt;
 }
 
-#define TEGA_REQUIRE_COLMAP(var)                                          \
-  const std::optional<fs::path> var = colmap_executable();               \
+#define TEGA_REQUIRE_COLMAP(var)                           \
+  const std::optional<fs::path> var = colmap_executable(); \
   if (!var) GTEST_SKIP() << "colmap (COLMAP 3.8) is not on PATH"
 
 // Runs colmap headless; fails the test with its output when it fails.
@@ -66,16 +66,23 @@ TEST(ColmapInterop, StereoFusionFusesTegasDepthMaps) {
   // Each view sees the sphere in ~16000 pixels; a fused point takes at least
   // COLMAP's min_num_pixels (5), most many more.
   EXPECT_GT(fused.size(), 3000);
-  int off_surface = 0, inward = 0;
+  int off_surface = 0, inward = 0, miscoloured = 0;
   double worst = 0;
+  ASSERT_EQ(fused.colors.rows(), fused.size());
   for (int i = 0; i < fused.size(); ++i) {
     const Eigen::Vector3f p = fused.points.row(i).transpose();
     off_surface += distance_to_sphere(p) > 0.001;
     worst = std::max(worst, distance_to_sphere(p));
     inward += fused.normals.row(i).dot(p.normalized().transpose()) < 0.9f;
+    // The images colour the sphere by position (sphere_image): COLMAP read them, in RGB order.
+    const Eigen::Vector3f expected = Eigen::Vector3f::Constant(127.5f) + 127 * p / float(kRadius);
+    miscoloured += (fused.colors.row(i).cast<float>().transpose() - expected).cwiseAbs().maxCoeff() > 20;
   }
   EXPECT_EQ(off_surface, 0) << "farthest " << worst << " m";
   EXPECT_EQ(inward, 0);
+  // At the silhouette the pixel's centre may miss the sphere that its depth
+  // (half a pixel off) hits, and COLMAP takes that pixel's background colour.
+  EXPECT_LT(miscoloured, fused.size() / 200);
 }
 
 TEST(ColmapInterop, PoissonMesherMeshesTegasFusedCloud) {
@@ -84,10 +91,11 @@ TEST(ColmapInterop, PoissonMesherMeshesTegasFusedCloud) {
   write_point_cloud_ply(test::sphere_cloud(20000, kRadius), dir / "fused.ply");
   // Depth 7 (~2 mm cells) keeps the run short; COLMAP's default trim (10)
   // would cut every vertex at that depth, whose densities are about 6.
-  run_colmap(*colmap,
-             "poisson_mesher --PoissonMeshing.depth 7 --PoissonMeshing.trim 0 --input_path '" +
-                 (dir / "fused.ply").string() + "' --output_path '" + (dir / "meshed-poisson.ply").string() + "'",
-             dir / "poisson.log");
+  run_colmap(
+      *colmap,
+      "poisson_mesher --PoissonMeshing.depth 7 --PoissonMeshing.trim 0 --PoissonMeshing.num_threads 1 --input_path '" +
+          (dir / "fused.ply").string() + "' --output_path '" + (dir / "meshed-poisson.ply").string() + "'",
+      dir / "poisson.log");
   const Mesh mesh = read_ply(dir / "meshed-poisson.ply");
   ASSERT_GT(mesh.num_faces(), 5000);
   double worst = 0;

@@ -70,7 +70,9 @@ TEST(ColmapArray, WritesColmapsHeaderThenChannelAfterChannel) {
   EXPECT_EQ(width, 2);
   EXPECT_EQ(height, 1);
   EXPECT_EQ(channels, 2);
-  EXPECT_CONTAINS(error_of([&] { write_colmap_array(dir / "b.bin", 2, 2, 1, {1, 2, 3}); }),
+  EXPECT_CONTAINS(error_of([&] {
+                    write_colmap_array(dir / "b.bin", 2, 2, 1, {1, 2, 3});
+                  }),
                   (dir / "b.bin").string() + ": size mismatch");
   EXPECT_FALSE(fs::exists(dir / "b.bin"));
 }
@@ -141,9 +143,9 @@ TEST(DenseWorkspace, RoundTripKeepsEverything) {
   const DenseWorkspace workspace = sphere_workspace();
   write_dense_workspace(workspace, dir / "ws");
 
-  for (const char* file : {"images/cam00.png", "sparse/cameras.txt", "sparse/images.txt", "sparse/points3D.txt",
-                           "stereo/depth_maps/cam01.png.geometric.bin", "stereo/normal_maps/cam01.png.geometric.bin",
-                           "fused.ply"})
+  for (const char* file :
+       {"images/cam00.png", "sparse/cameras.txt", "sparse/images.txt", "sparse/points3D.txt",
+        "stereo/depth_maps/cam01.png.geometric.bin", "stereo/normal_maps/cam01.png.geometric.bin", "fused.ply"})
     EXPECT_TRUE(fs::exists(dir / "ws" / file)) << file;
   EXPECT_EQ(read_bytes(dir / "ws/stereo/patch-match.cfg"), "cam00.png\ncam01.png, cam02.png\ncam02.png\ncam00.png\n");
   EXPECT_EQ(read_bytes(dir / "ws/stereo/fusion.cfg"), "cam00.png\ncam01.png\ncam02.png\n");
@@ -202,8 +204,7 @@ TEST(DenseWorkspace, ReadsColmapsFilesWrittenByHand) {
   const fs::path ws = dir / "ws";
   for (const char* folder : {"sparse", "images", "stereo"}) fs::create_directories(ws / folder);
   tega::test::write_text(ws / "sparse/cameras.txt", "1 PINHOLE 3 2 100 100 1.5 1\n");
-  tega::test::write_text(ws / "sparse/images.txt",
-                         "1 1 0 0 0 0 0 0 1 left.png\n\n2 1 0 0 0 0.1 0 0 1 right.png\n\n");
+  tega::test::write_text(ws / "sparse/images.txt", "1 1 0 0 0 0 0 0 1 left.png\n\n2 1 0 0 0 0.1 0 0 1 right.png\n\n");
   tega::test::write_text(ws / "sparse/points3D.txt", "");
   for (const char* name : {"left.png", "right.png"}) write_image(Image8(3, 2, 1, 77), ws / "images" / name);
   // Planar: row 0 then row 1; -1 is COLMAP's "no estimate".
@@ -243,7 +244,7 @@ TEST(DenseWorkspace, RefusesWhatItCannotWrite) {
   DenseWorkspace workspace = sphere_workspace();
   workspace.source_views["cam01"] = {"cam09"};
   EXPECT_CONTAINS(error_of([&] { write_dense_workspace(workspace, dir / "ws"); }),
-                  "a source view of camera 'cam09', which is not in the rig");
+                  "source view 'cam09' of camera 'cam01' is not in the rig");
   workspace = sphere_workspace();
   workspace.rig.cameras[1].distortion[0] = 0.1;
   EXPECT_CONTAINS(error_of([&] { write_dense_workspace(workspace, dir / "ws"); }), "camera 'cam01' has distortion");

@@ -17,7 +17,8 @@ std::vector<int> upper_faces(const Mesh& mesh) {
   std::vector<int> faces;
   for (int f = 0; f < mesh.num_faces(); ++f)
     if (mesh.positions(mesh.faces(f, 0), 2) + mesh.positions(mesh.faces(f, 1), 2) +
-            mesh.positions(mesh.faces(f, 2), 2) > 0)
+            mesh.positions(mesh.faces(f, 2), 2) >
+        0)
       faces.push_back(f);
   return faces;
 }
@@ -103,8 +104,8 @@ TEST(Evaluation, DistancesToMeshMatchBruteForce) {
       const Eigen::Vector3d c = mesh.positions.row(mesh.faces(f, 2)).cast<double>();
       const Eigen::Vector3d n = (b - a).cross(c - a).normalized();
       const Eigen::Vector3d q = p - n * n.dot(p - a);
-      const bool inside = (b - a).cross(q - a).dot(n) >= 0 && (c - b).cross(q - b).dot(n) >= 0 &&
-                          (a - c).cross(q - c).dot(n) >= 0;
+      const bool inside =
+          (b - a).cross(q - a).dot(n) >= 0 && (c - b).cross(q - b).dot(n) >= 0 && (a - c).cross(q - c).dot(n) >= 0;
       best = std::min(best, inside ? (p - q).norm() : std::min({segment(p, a, b), segment(p, b, c), segment(p, c, a)}));
     }
     EXPECT_NEAR(fast[size_t(i)], best, 1e-12) << "point " << i;

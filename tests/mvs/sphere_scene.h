@@ -114,8 +114,8 @@ inline OrientedPointCloud sphere_cloud(int count, double radius, double min_z = 
 // counter-clockwise seen from outside.
 inline Mesh sphere_mesh(double radius, int levels) {
   const double g = (1 + std::sqrt(5.0)) / 2;
-  std::vector<Eigen::Vector3d> vertices = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
-                                           {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
+  std::vector<Eigen::Vector3d> vertices = {{-1, g, 0},  {1, g, 0},  {-1, -g, 0}, {1, -g, 0}, {0, -1, g},  {0, 1, g},
+                                           {0, -1, -g}, {0, 1, -g}, {g, 0, -1},  {g, 0, 1},  {-g, 0, -1}, {-g, 0, 1}};
   std::vector<Eigen::Vector3i> faces = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
                                         {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
                                         {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
@@ -138,7 +138,8 @@ inline Mesh sphere_mesh(double radius, int levels) {
   }
   Mesh mesh;
   mesh.positions.resize(Eigen::Index(vertices.size()), 3);
-  for (size_t i = 0; i < vertices.size(); ++i) mesh.positions.row(Eigen::Index(i)) = (radius * vertices[i]).cast<float>().transpose();
+  for (size_t i = 0; i < vertices.size(); ++i)
+    mesh.positions.row(Eigen::Index(i)) = (radius * vertices[i]).cast<float>().transpose();
   mesh.faces.resize(Eigen::Index(faces.size()), 3);
   for (size_t i = 0; i < faces.size(); ++i) mesh.faces.row(Eigen::Index(i)) = faces[i].transpose();
   return mesh;

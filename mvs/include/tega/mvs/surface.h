@@ -13,7 +13,8 @@ struct SurfaceOptions {
   // Vertices whose Poisson density (point support) is below this quantile of all
   // vertex densities are removed, with their faces.
   double trim_density_quantile = 0.05;
-  // Faces farther than this from every input point are removed (metres; 0 = off).
+  // Faces farther than this from every input point are removed (metres; 0 = off),
+  // measured at their vertices: a face stays while one of its vertices is near a point.
   double trim_distance_m = 0.003;
   // Connected components with fewer faces than this share of the largest are removed.
   double min_component_share = 0.05;
@@ -32,7 +33,8 @@ struct SurfaceOptions {
   }
 };
 
-// Throws tega::Error when the cloud is empty or has no normals.
+// Faces wind counter-clockwise seen from outside, the side the cloud's
+// normals point to. Throws tega::Error when the cloud is empty or has no normals.
 Mesh reconstruct_surface(const OrientedPointCloud& cloud, const SurfaceOptions& options);
 
 }  // namespace tega::mvs
