@@ -334,4 +334,40 @@ FrameTimings reconstruct_photos(const PhotoRequest& request, const Options& opti
   return r.timings;
 }
 
+FrameTimings mesh_workspace(const fs::path& workspace, const fs::path& out, const Options& options,
+                            const std::string& type) {
+  FrameTimings timings;
+  auto start = Clock::now();
+  const DenseWorkspace input = read_dense_workspace(workspace, type);
+  std::vector<StereoView> views;
+  std::vector<int> map_views;
+  std::vector<DepthMap> maps;
+  for (const auto& camera : input.rig.cameras) {
+    const auto map = input.depth_maps.find(camera.name);
+    if (map == input.depth_maps.end()) continue;
+    StereoView view;
+    view.camera = camera;
+    view.colour = rgb_of(input.images.at(camera.name));
+    view.grey = grey_of(view.colour);
+    map_views.push_back(int(views.size()));
+    maps.push_back(map->second);
+    views.push_back(std::move(view));
+  }
+  if (views.size() < 2) throw Error(workspace, "has depth maps (" + type + ") for fewer than two views");
+  timings.load_s = seconds_since(start);
+
+  ThreadPool pool(options.threads);
+  start = Clock::now();
+  const OrientedPointCloud cloud = fuse_depth_maps(views, map_views, maps, options.fusion, &pool);
+  timings.fusion_s = seconds_since(start);
+  if (cloud.size() < 100)
+    throw Error(workspace, "only " + std::to_string(cloud.size()) + " points survived fusion of its depth maps");
+  start = Clock::now();
+  SurfaceOptions surface = options.surface;
+  if (surface.threads == 0) surface.threads = pool.size();
+  write_mesh(reconstruct_surface(cloud, surface), out);
+  timings.surface_s = seconds_since(start);
+  return timings;
+}
+
 }  // namespace tega::mvs

@@ -1,5 +1,6 @@
 #include "tega/mvs/studio_truth.h"
 
+#include <Eigen/Geometry>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
@@ -47,15 +48,15 @@ StudioTruth load_studio_truth(const std::filesystem::path& capture, const std::s
   std::snprintf(name, sizeof name, "%06d.bin", frame);
   truth.fine.positions = read_vertices_bin(capture / "ground_truth" / take / "fine" / name, truth.fine.num_vertices());
 
+  // Subdivision emits each coarse triangle's fine triangles as one run, in order.
   const std::vector<bool> region = coarse_face_region(coarse, head);
-  if (truth.fine.triangle_polygon.size() != size_t(truth.fine.num_faces()))
-    throw Error(head_dir / "fine_topology.obj", "does not name the coarse triangle of each fine triangle");
-  for (int f = 0; f < truth.fine.num_faces(); ++f) {
-    const int coarse_face = truth.fine.triangle_polygon[size_t(f)];
-    if (coarse_face < 0 || coarse_face >= coarse.num_faces())
-      throw Error(head_dir / "fine_topology.obj", "names a coarse triangle the template does not have");
-    if (region[size_t(coarse_face)]) truth.face_region.push_back(f);
-  }
+  const int run = coarse.num_faces() > 0 ? truth.fine.num_faces() / coarse.num_faces() : 0;
+  if (run == 0 || run * coarse.num_faces() != truth.fine.num_faces())
+    throw Error(head_dir / "fine_topology.obj", "does not subdivide template.obj (" +
+                                                   std::to_string(truth.fine.num_faces()) + " triangles for " +
+                                                   std::to_string(coarse.num_faces()) + ")");
+  for (int f = 0; f < truth.fine.num_faces(); ++f)
+    if (region[size_t(f / run)]) truth.face_region.push_back(f);
   return truth;
 }
 

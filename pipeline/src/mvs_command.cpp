@@ -13,7 +13,7 @@ namespace tega::cli {
 namespace {
 
 struct MvsArguments {
-  std::string capture, out, rig, frames, config, device, images, workspace_dir;
+  std::string capture, out, rig, frames, config, device, images, workspace_dir, map_type = "geometric";
   double rig_metres_per_unit = 1.0;
   std::vector<std::string> takes, overrides;
   int threads = -1;
@@ -65,6 +65,20 @@ void add_photos_command(CLI::App& mvs_command, const std::shared_ptr<MvsArgument
   });
 }
 
+void add_mesh_workspace_command(CLI::App& mvs_command, const std::shared_ptr<MvsArguments>& args) {
+  auto* cmd = mvs_command.add_subcommand(
+      "mesh-workspace",
+      "Fuse and mesh the depth maps of a COLMAP dense workspace (COLMAP's patch_match_stereo output or tega's).");
+  cmd->add_option("--workspace", args->workspace_dir, "The workspace: images/, sparse/ (text), stereo/.")->required();
+  cmd->add_option("--type", args->map_type, "Depth maps to read: geometric (default) or photometric.");
+  cmd->add_option("--out", args->out, "The mesh to write (.ply).")->required();
+  add_shared_options(*cmd, args);
+  cmd->callback([args] {
+    const auto t = mvs::mesh_workspace(args->workspace_dir, args->out, options_of(*args), args->map_type);
+    std::printf("%s: load %.1f s, fusion %.1f s, surface %.1f s\n", args->out.c_str(), t.load_s, t.fusion_s, t.surface_s);
+  });
+}
+
 }  // namespace
 
 void add_mvs_command(CLI::App& app) {
@@ -84,6 +98,7 @@ void add_mvs_command(CLI::App& app) {
   cmd->add_flag("--print-options", args->print_options, "Print every mvs option with its default and exit.");
   cmd->require_subcommand(0, 1);
   add_photos_command(*cmd, args);
+  add_mesh_workspace_command(*cmd, args);
   cmd->callback([cmd, args] {
     if (!cmd->get_subcommands().empty()) return;
     const mvs::Options options = options_of(*args);

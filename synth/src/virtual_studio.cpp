@@ -43,8 +43,8 @@ void write_head_ground_truth(const std::filesystem::path& dir, const Head& head,
       {"source", head.source},
       {"template", "template.obj"},
       {"fine_topology", "fine_topology.obj"},
-      {"fine_note", "fine meshes: fine_topology.obj's faces and UVs; each fine triangle's OBJ polygon is the "
-                    "coarse triangle it subdivides"},
+      {"fine_note", "fine meshes: fine_topology.obj's faces and UVs; its triangles come in runs of "
+                    "4^fine_subdivisions, one run per triangle of template.obj, in that order"},
       {"eyeball_faces", head.eyeball_faces},
       {"expressions", head.model.expression_names},
       {"eye_left", vec(head.frame.eye_left)},

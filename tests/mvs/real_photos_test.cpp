@@ -61,6 +61,8 @@ TEST(RealPhotos, AloeDisparityMatchesMiddleburyTruth) {
   const std::vector<ViewTask> tasks = {{0, {1}, depth_min, depth_max}, {1, {0}, depth_min, depth_max}};
   PatchMatchOptions options;
   options.top_k = 1;
+  options.iterations = 4;
+  options.geometric_iterations = 1;
   ThreadPool pool(0);
   const auto maps = estimate_depth_maps(views, tasks, options, Device::cpu, &pool);
 

@@ -9,6 +9,7 @@
 
 #include "pipeline_test_support.h"
 #include "tega/core/files.h"
+#include "tega/core/mesh.h"
 #include "test_support.h"
 
 namespace tega::test {
@@ -225,7 +226,7 @@ TEST(TegaRun, StagesThatDoNotExistYetAreReportedNotFaked) {
   const fs::path config = fs::path(TEGA_STUDIO_CONFIGS) / "studio13-capture.yaml";
   const auto r = run_tega({"run", config.string(), "--workspace", (dir / "ws").string()}, dir.path());
   EXPECT_EQ(r.exit_code, 1) << r.output;
-  for (const char* stage : {"mvs", "tracking", "matting"}) {
+  for (const char* stage : {"tracking", "matting"}) {
     EXPECT_NE(r.output.find(std::string(stage) + "/default unavailable: not implemented in tega yet"), std::string::npos)
         << stage << "\n"
         << r.output;
@@ -235,7 +236,7 @@ TEST(TegaRun, StagesThatDoNotExistYetAreReportedNotFaked) {
   for (const auto& stage : status["stages"]) {
     if (stage["kind"] == "train") {
       EXPECT_EQ(stage["shards"][0]["state"], stage["available"] ? "pending" : "unavailable");
-    } else if (stage["kind"] == "capture" || stage["kind"] == "calibrate") {
+    } else if (stage["kind"] == "capture" || stage["kind"] == "calibrate" || stage["kind"] == "mvs") {
       EXPECT_TRUE(stage["available"]) << stage;  // capture runs, and fails: this machine has no studio cameras
     } else if (stage["kind"] != "eval" && stage["kind"] != "render") {
       EXPECT_FALSE(stage["available"]) << stage;
@@ -287,6 +288,34 @@ TEST(TegaRun, CalibratesTheRigFromTheCapturesCalibrationTake) {
   const json report = json::parse(read_text_file(dir / "ws/calibrate/default/rig.report.json"));
   EXPECT_EQ(report["cameras"].size(), 3u);
   EXPECT_LE(report["rms_px"].get<double>(), 0.5);
+}
+
+// The calibrated rig meshes every performance frame; a shard stopped half way
+// keeps its finished frames (the stage resumes in its staging directory).
+TEST(TegaRun, MeshesEveryPerformanceFrameWithTheCalibratedRig) {
+  REQUIRE_SYNTH();
+  if (!tega_has_command({"mvs"})) GTEST_SKIP() << "this build has no `tega mvs` (Open3D + OpenCV)";
+  if (!tega_has_command({"calibrate"})) GTEST_SKIP() << "this build has no `tega calibrate` (OpenCV + Ceres)";
+  TempDir dir;
+  write_text(dir / "board.yaml", "type: charuco\nsquares_x: 7\nsquares_y: 5\nsquare_m: 0.04\nmarker_m: 0.03\n");
+  write_text(dir / "studio.yaml",
+             "workspace: ws\nstages:\n"
+             "  synth:\n    options:\n"
+             "      studio: {cameras: 5, width: 320, height: 240}\n      calibration_frames: 12\n"
+             "      frames: 2\n      takes: [speech]\n      test_takes: []\n      write_fine_meshes: false\n"
+             "  calibrate: {after: synth, options: {board: board.yaml}}\n"
+             "  mvs:\n    after: calibrate\n    options:\n      device: cpu\n"
+             "      patch_match: {iterations: 3, geometric_iterations: 1}\n");
+  const auto r = run_tega({"run", (dir / "studio.yaml").string()}, dir.path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const json status = status_json(dir / "ws", dir.path());
+  EXPECT_EQ(shard_state(status, "mvs", "default"), "done");
+  for (const char* frame : {"000000", "000001"}) {
+    const fs::path mesh = dir / "ws/mvs/default/meshes/speech" / (std::string(frame) + ".ply");
+    ASSERT_TRUE(fs::exists(mesh)) << mesh;
+    EXPECT_GT(read_mesh(mesh).num_faces(), 1000);
+  }
+  EXPECT_FALSE(fs::exists(dir / "ws/mvs/default/.resume-key"));
 }
 
 TEST(TegaRun, TheShippedConfigsAreValidGraphs) {

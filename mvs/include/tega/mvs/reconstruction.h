@@ -103,6 +103,11 @@ struct PhotoRequest {
 };
 FrameTimings reconstruct_photos(const PhotoRequest& request, const Options& options);
 
+// Fusion and meshing of a COLMAP dense workspace's depth and normal maps
+// (COLMAP's `patch_match_stereo` output, or tega's): the mesh (PLY) to `out`.
+FrameTimings mesh_workspace(const std::filesystem::path& workspace, const std::filesystem::path& out,
+                            const Options& options, const std::string& type = "geometric");
+
 // "A:B" (B exclusive), "A:" or "A" into [first, end). Throws tega::Error.
 void parse_frame_range(const std::string& text, int& first, int& end);
 

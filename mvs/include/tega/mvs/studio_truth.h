@@ -8,7 +8,8 @@
 // interocular distances, +y up, +z out of the face): triangles within 1.1
 // to either side, from 1.9 below the eyes to 1.1 above, in front of 0.9
 // behind them, facing forward. Each fine triangle belongs to the coarse
-// triangle it subdivides.
+// triangle it subdivides (fine_topology.obj holds them in runs, one per
+// coarse triangle).
 
 #include <filesystem>
 #include <string>

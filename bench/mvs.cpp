@@ -1,0 +1,208 @@
+// bench/mvs: one frame of a virtual-studio take through multi-view stereo,
+// each stage timed (load, depth, fusion, surface) and scored against the
+// studio's ground truth: depth maps against rendered true depth, and (where
+// tega_mvs is built) the mesh's accuracy and completeness over the face.
+// The capture is rendered once into --capture and kept for the next run.
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+
+#include "tega/core/mesh.h"
+#include "tega/core/thread_pool.h"
+#include "tega/core/undistort.h"
+#include "tega/mvs/frame_views.h"
+#include "tega/mvs/fusion.h"
+#include "tega/mvs/patch_match.h"
+#include "tega/mvs/view_selection.h"
+#include "tega/synth/ground_truth_depth.h"
+#include "tega/synth/virtual_studio.h"
+#ifdef TEGA_BENCH_HAVE_MVS
+#include "tega/core/options.h"
+#include "tega/mvs/colmap_workspace.h"
+#include "tega/mvs/evaluation.h"
+#include "tega/mvs/masks.h"
+#include "tega/mvs/reconstruction.h"
+#include "tega/mvs/studio_truth.h"
+#endif
+
+namespace fs = std::filesystem;
+using namespace tega;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+fs::path render_capture(const fs::path& root, int cameras, int width, int height) {
+  if (fs::exists(root / "capture.json")) return root;
+  std::printf("rendering %d cameras at %dx%d into %s (once)...\n", cameras, width, height, root.c_str());
+  synth::Options o;
+  o.studio.cameras = cameras;
+  o.studio.width = width;
+  o.studio.height = height;
+  o.frames = 2;
+  o.calibration_frames = 0;
+  o.takes = {"expressions"};
+  o.test_takes = {};
+  o.test_cameras = 1;
+  synth::render_virtual_studio(o, root, true);
+  return root;
+}
+
+// Masks from the true coverage (builds without OpenCV have no clean-plate masks).
+void mask_from_truth(std::vector<mvs::StereoView>& views, const fs::path& root, const Rig& rig, int frame) {
+  for (auto& view : views) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%06d.png", frame);
+    const Image8 alpha = read_image_u8(root / "ground_truth" / "expressions" / "alpha" / view.camera.name / name);
+    const Image8 undistorted = undistort_image(alpha, rig.camera(view.camera.name));
+    view.mask.resize(undistorted.pixels.size());
+    for (size_t i = 0; i < view.mask.size(); ++i) view.mask[i] = undistorted.pixels[i] > 0 ? 255 : 0;
+  }
+}
+
+struct DepthScore {
+  int64_t estimated = 0, covered = 0, within_1mm = 0, within_2mm = 0, covered_and_estimated = 0;
+  std::vector<float> errors;
+};
+
+void score_depth(const mvs::DepthMap& map, const ImageF& truth, DepthScore& score) {
+  for (size_t i = 0; i < map.depth.size(); ++i) {
+    const float t = truth.pixels[i], d = map.depth[i];
+    score.covered += t > 0;
+    if (d <= 0) continue;
+    ++score.estimated;
+    if (t <= 0) continue;
+    ++score.covered_and_estimated;
+    const float e = std::abs(d - t);
+    score.within_1mm += e < 0.001f;
+    score.within_2mm += e < 0.002f;
+    score.errors.push_back(e);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Multi-view stereo time and accuracy on one virtual-studio frame."};
+  int cameras = 13, width = 512, height = 384, frame = 0, threads = 0, window_radius = 0, window_step = 0;
+  std::string device = "cpu", capture = (fs::temp_directory_path() / "tega-mvs-bench").string(), out, config;
+  app.add_option("--cameras", cameras, "Cameras.");
+  app.add_option("--width", width, "Image width.");
+  app.add_option("--height", height, "Image height.");
+  app.add_option("--frame", frame, "Frame of the take.");
+  app.add_option("--device", device, "cpu or cuda.");
+  app.add_option("--threads", threads, "CPU threads (0 = all).");
+  app.add_option("--capture", capture, "Where the rendered capture is kept between runs (suffixed with its size).");
+  app.add_option("--out", out, "Write the fused cloud (fused.ply) here, and the mesh (mesh.ply) where it is made.");
+  app.add_option("--window-radius", window_radius, "PatchMatch window radius in pixels (default: the options').");
+  app.add_option("--window-step", window_step, "PatchMatch window step in pixels (default: the options').");
+#ifdef TEGA_BENCH_HAVE_MVS
+  app.add_option("--config", config, "YAML whose `mvs` section sets the options.");
+#endif
+  CLI11_PARSE(app, argc, argv);
+
+  const fs::path root = render_capture(capture + "-" + std::to_string(cameras) + "-" + std::to_string(width) + "x" +
+                                           std::to_string(height),
+                                       cameras, width, height);
+  ThreadPool pool(threads);
+  const Rig rig = read_rig_json(root / "rig.json");
+  const mvs::FrameLoader loader(read_take(root / "takes" / "expressions"), rig, (root / "rig.json").string());
+#ifdef TEGA_BENCH_HAVE_MVS
+  mvs::Options options;
+  if (!config.empty()) load_options(options, config, "mvs");
+  mvs::PatchMatchOptions pm = options.patch_match;
+  const mvs::FusionOptions fusion_options = options.fusion;
+#else
+  mvs::PatchMatchOptions pm;
+  const mvs::FusionOptions fusion_options;
+#endif
+  if (window_radius > 0) pm.window_radius = window_radius;
+  if (window_step > 0) pm.window_step = window_step;
+  if (device == "cuda" && !mvs::cuda_device_available()) {
+    std::fprintf(stderr, "mvs_bench: no CUDA device\n");
+    return 1;
+  }
+
+  auto start = Clock::now();
+  std::vector<mvs::StereoView> views = loader.load(frame, pool);
+#ifdef TEGA_BENCH_HAVE_MVS
+  const mvs::FrameLoader plate_loader(read_take(root / "takes" / "clean_plate"), rig, (root / "rig.json").string());
+  const auto plates = plate_loader.load(0, pool);
+  for (size_t k = 0; k < views.size(); ++k) views[k].mask = mvs::subject_mask(views[k].colour, plates[k].colour, options.mask);
+  const char* mask_source = "clean plate";
+#else
+  mask_from_truth(views, root, rig, frame);
+  const char* mask_source = "true coverage";
+#endif
+  const double load_s = seconds_since(start);
+
+  std::vector<Camera> pinholes;
+  for (const auto& v : views) pinholes.push_back(v.camera);
+  const Eigen::Vector3d focus = *mvs::rig_focus_point(pinholes);
+  const auto sources = mvs::select_source_views(pinholes, focus, pm.source_views);
+  std::vector<mvs::ViewTask> tasks;
+  std::vector<int> map_views;
+  for (size_t k = 0; k < views.size(); ++k) {
+    const double centre = views[k].camera.world_to_camera.apply(focus).z();
+    tasks.push_back({int(k), sources[k], float(centre - 0.3), float(centre + 0.3)});
+    map_views.push_back(int(k));
+  }
+
+  start = Clock::now();
+  const auto maps = mvs::estimate_depth_maps(views, tasks, pm, mvs::parse_device(device), &pool);
+  const double depth_s = seconds_since(start);
+  start = Clock::now();
+  const mvs::OrientedPointCloud cloud = mvs::fuse_depth_maps(views, map_views, maps, fusion_options, &pool);
+  const double fusion_s = seconds_since(start);
+
+  // Depth maps against the true fine mesh.
+  const Mesh fine_topology = read_obj(root / "ground_truth" / "head" / "fine_topology.obj");
+  char name[32];
+  std::snprintf(name, sizeof name, "%06d.bin", frame);
+  const Vertices fine = read_vertices_bin(root / "ground_truth" / "expressions" / "fine" / name);
+  DepthScore score;
+  for (size_t k = 0; k < views.size(); ++k)
+    score_depth(maps[k], synth::render_depth(views[k].camera, fine, fine_topology.faces), score);
+  std::sort(score.errors.begin(), score.errors.end());
+  std::printf("mvs bench: %d cameras %dx%d, frame %d, depth on %s, %d threads, masks from the %s\n", cameras, width,
+              height, frame, device.c_str(), pool.size(), mask_source);
+  std::printf("depth maps: %lld pixels estimated; of those on the head: median error %.3f mm, %.1f %% within 1 mm, "
+              "%.1f %% within 2 mm; %.1f %% of the head's pixels estimated\n",
+              (long long)score.estimated, score.errors.empty() ? 0.0 : 1000 * score.errors[score.errors.size() / 2],
+              100.0 * score.within_1mm / std::max<int64_t>(1, score.covered_and_estimated),
+              100.0 * score.within_2mm / std::max<int64_t>(1, score.covered_and_estimated),
+              100.0 * score.covered_and_estimated / std::max<int64_t>(1, score.covered));
+  std::printf("fused cloud: %d points\n", cloud.size());
+
+  double surface_s = 0;
+#ifdef TEGA_BENCH_HAVE_MVS
+  start = Clock::now();
+  const Mesh mesh = mvs::reconstruct_surface(cloud, options.surface);
+  surface_s = seconds_since(start);
+  const mvs::StudioTruth truth = mvs::load_studio_truth(root, "expressions", frame);
+  mvs::EvaluationOptions eval;
+  eval.tolerances_m = {0.001, 0.002, 0.003};
+  const auto s = mvs::evaluate_surface(mesh, truth.fine, truth.face_region, eval);
+  std::printf("mesh: %d vertices, %d faces; accuracy median %.3f mm, mean %.3f mm, p90 %.3f mm; completeness over the "
+              "face %.1f %% at 1 mm, %.1f %% at 2 mm, %.1f %% at 3 mm\n",
+              mesh.num_vertices(), mesh.num_faces(), 1000 * s.accuracy_median_m, 1000 * s.accuracy_mean_m,
+              1000 * s.accuracy_p90_m, 100 * s.completeness[0], 100 * s.completeness[1], 100 * s.completeness[2]);
+  if (!out.empty()) {
+    fs::create_directories(out);
+    write_mesh(mesh, fs::path(out) / "mesh.ply");
+  }
+#endif
+  if (!out.empty()) {
+    fs::create_directories(out);
+#ifdef TEGA_BENCH_HAVE_MVS
+    mvs::write_point_cloud_ply(cloud, fs::path(out) / "fused.ply");
+#endif
+  }
+  std::printf("%-10s %8s\n", "stage", "seconds");
+  std::printf("%-10s %8.2f\n%-10s %8.2f\n%-10s %8.2f\n%-10s %8.2f\n%-10s %8.2f\n", "load", load_s, "depth", depth_s,
+              "fusion", fusion_s, "surface", surface_s, "total", load_s + depth_s + fusion_s + surface_s);
+  return 0;
+}

@@ -1,0 +1,142 @@
+// tega mvs on a 13-camera virtual-studio capture at 512 x 384, scored against
+// its ground truth (the CPU targets), plus resuming and bad input.
+// The capture is rendered once; tests that damage it work on a copy.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "tega/core/error.h"
+#include "tega/core/files.h"
+#include "tega/core/rig.h"
+#include "tega/mvs/evaluation.h"
+#include "tega/mvs/reconstruction.h"
+#include "tega/mvs/studio_truth.h"
+#include "tega/synth/virtual_studio.h"
+#include "test_support.h"
+
+namespace fs = std::filesystem;
+
+namespace tega::mvs {
+namespace {
+
+const fs::path& studio_capture() {
+  static const test::TempDir dir;
+  static const fs::path root = [] {
+    synth::Options o;
+    o.frames = 2;
+    o.calibration_frames = 0;
+    o.takes = {"expressions"};
+    o.test_takes = {};
+    o.test_cameras = 1;
+    synth::render_virtual_studio(o, dir / "capture");
+    return dir / "capture";
+  }();
+  return root;
+}
+
+Options cpu_options() {
+  Options o;
+  o.device = "cpu";
+  return o;
+}
+
+std::string error_of(const std::function<void()>& run) {
+  try {
+    run();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// A copy of the capture with frame 1 only, to damage.
+fs::path copy_capture(const test::TempDir& dir) {
+  fs::copy(studio_capture(), dir / "capture", fs::copy_options::recursive);
+  return dir / "capture";
+}
+
+TEST(Mvs, MeshesTheFaceWithinTheTargets) {
+  const test::TempDir out;
+  MvsRequest request;
+  request.capture = studio_capture();
+  request.out = out / "meshes";
+  request.end_frame = 1;
+  const MvsSummary summary = reconstruct_capture(request, cpu_options());
+  EXPECT_EQ(summary.frames_done, 1);
+  const Mesh mesh = read_mesh(out / "meshes" / "expressions" / "000000.ply");
+  const StudioTruth truth = load_studio_truth(studio_capture(), "expressions", 0);
+  EvaluationOptions eval;
+  eval.tolerances_m = {0.003};
+  const SurfaceScores scores = evaluate_surface(mesh, truth.fine, truth.face_region, eval);
+  std::printf("512x384, 13 cameras: accuracy median %.2f mm (p90 %.2f mm), completeness at 3 mm %.1f %%\n",
+              1000 * scores.accuracy_median_m, 1000 * scores.accuracy_p90_m, 100 * scores.completeness[0]);
+  EXPECT_LE(scores.accuracy_median_m, 0.002);
+  EXPECT_GE(scores.completeness[0], 0.90);
+
+  const auto record = nlohmann::json::parse(read_text_file(out / "meshes" / "expressions" / "000000.json"));
+  EXPECT_EQ(record["depth_map_cameras"].size(), 13u);
+  EXPECT_GT(record["points"].get<int>(), 10000);
+
+  // Run again: the frame is done with these options and rig, and kept.
+  const auto before = fs::last_write_time(out / "meshes" / "expressions" / "000000.ply");
+  const MvsSummary again = reconstruct_capture(request, cpu_options());
+  EXPECT_EQ(again.frames_skipped, 1);
+  EXPECT_EQ(again.frames_done, 0);
+  EXPECT_EQ(fs::last_write_time(out / "meshes" / "expressions" / "000000.ply"), before);
+}
+
+TEST(Mvs, ACameraMissingFromTheRigIsNamed) {
+  const test::TempDir dir;
+  const fs::path capture = copy_capture(dir);
+  Rig rig = read_rig_json(capture / "rig.json");
+  rig.cameras.erase(rig.cameras.begin() + 4);
+  write_rig_json(rig, dir / "partial-rig.json");
+  MvsRequest request{capture, {}, dir / "meshes", dir / "partial-rig.json", 1, 2};
+  const std::string error = error_of([&] { reconstruct_capture(request, cpu_options()); });
+  EXPECT_NE(error.find("partial-rig.json"), std::string::npos) << error;
+  EXPECT_NE(error.find("cam04"), std::string::npos) << error;
+  EXPECT_FALSE(fs::exists(dir / "meshes" / "expressions" / "000001.ply"));
+}
+
+TEST(Mvs, AnUnreadableImageNamesTheFrameAndFileAndLeavesNoMesh) {
+  const test::TempDir dir;
+  const fs::path capture = copy_capture(dir);
+  const fs::path image = capture / "takes" / "expressions" / "cam07" / "000001.png";
+  write_text_atomic(image, "not a png");
+  MvsRequest request{capture, {}, dir / "meshes", {}, 1, 2};
+  const std::string error = error_of([&] { reconstruct_capture(request, cpu_options()); });
+  EXPECT_NE(error.find("frame 1"), std::string::npos) << error;
+  EXPECT_NE(error.find(image.string()), std::string::npos) << error;
+  EXPECT_FALSE(fs::exists(dir / "meshes" / "expressions" / "000001.ply"));
+  EXPECT_FALSE(fs::exists(dir / "meshes" / "expressions" / "000001.json"));
+}
+
+TEST(Mvs, AFrameTooFewCamerasSeeIsRefused) {
+  const test::TempDir dir;
+  const fs::path capture = copy_capture(dir);
+  // All but two cameras see the empty studio in frame 1.
+  const auto cameras = read_rig_json(capture / "rig.json").camera_names();
+  for (size_t k = 2; k < cameras.size(); ++k)
+    fs::copy_file(capture / "takes" / "clean_plate" / cameras[k] / "000000.png",
+                  capture / "takes" / "expressions" / cameras[k] / "000001.png", fs::copy_options::overwrite_existing);
+  MvsRequest request{capture, {}, dir / "meshes", {}, 1, 2};
+  const std::string error = error_of([&] { reconstruct_capture(request, cpu_options()); });
+  EXPECT_NE(error.find("frame 1: the subject is seen by 2 camera(s) (cam00, cam01)"), std::string::npos) << error;
+  EXPECT_FALSE(fs::exists(dir / "meshes" / "expressions" / "000001.ply"));
+}
+
+TEST(Mvs, FrameRangesParse) {
+  int first = 0, end = 0;
+  parse_frame_range("3:7", first, end);
+  EXPECT_EQ(first, 3);
+  EXPECT_EQ(end, 7);
+  parse_frame_range("5:", first, end);
+  EXPECT_EQ(end, -1);
+  parse_frame_range("4", first, end);
+  EXPECT_EQ(end, 5);
+  EXPECT_THROW(parse_frame_range("7:3", first, end), Error);
+  EXPECT_THROW(parse_frame_range("a:b", first, end), Error);
+}
+
+}  // namespace
+}  // namespace tega::mvs
