@@ -12,6 +12,7 @@
 #include "tega/core/mesh.h"
 #include "tega/core/thread_pool.h"
 #include "tega/core/undistort.h"
+#include "tega/mvs/colmap_workspace.h"
 #include "tega/mvs/frame_views.h"
 #include "tega/mvs/fusion.h"
 #include "tega/mvs/patch_match.h"
@@ -20,7 +21,6 @@
 #include "tega/synth/virtual_studio.h"
 #ifdef TEGA_BENCH_HAVE_MVS
 #include "tega/core/options.h"
-#include "tega/mvs/colmap_workspace.h"
 #include "tega/mvs/evaluation.h"
 #include "tega/mvs/masks.h"
 #include "tega/mvs/reconstruction.h"
@@ -197,9 +197,7 @@ int main(int argc, char** argv) {
 #endif
   if (!out.empty()) {
     fs::create_directories(out);
-#ifdef TEGA_BENCH_HAVE_MVS
     mvs::write_point_cloud_ply(cloud, fs::path(out) / "fused.ply");
-#endif
   }
   std::printf("%-10s %8s\n", "stage", "seconds");
   std::printf("%-10s %8.2f\n%-10s %8.2f\n%-10s %8.2f\n%-10s %8.2f\n%-10s %8.2f\n", "load", load_s, "depth", depth_s,
