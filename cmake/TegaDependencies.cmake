@@ -16,6 +16,8 @@ tega_require(yaml-cpp libyaml-cpp-dev)
 tega_require(spdlog libspdlog-dev)
 tega_require(CLI11 libcli11-dev)
 tega_require(PNG libpng-dev)
+# SHA-256 of the orchestrator's manifests (libcrypto's EVP interface).
+tega_require(OpenSSL libssl-dev)
 find_package(Threads REQUIRED)
 
 # yaml-cpp 0.7 (Debian) exports "yaml-cpp"; newer releases "yaml-cpp::yaml-cpp".
