@@ -14,7 +14,7 @@
 //  - A halfedge mesh has one UV per halfedge and no UV numbering, so the
 //    fine mesh's UV seams and `uv_faces` would have to be rebuilt afterwards,
 //    and a coarse mesh with a non-manifold piece would not convert at all.
-// Linear 1-to-4 midpoints with weights is the twenty lines below.
+// Linear 1-to-4 midpoints that carry their weights take a page, below.
 
 #include <unordered_map>
 
