@@ -4,8 +4,8 @@
 // Written here rather than through OpenMesh's OBJ reader and writer, which
 // tega links (tega/core/openmesh.h), because OpenMesh cannot keep what tega's
 // meshes promise (docs/meshes-and-images.md, bench/mesh_io):
-//  - its reader is 5-7x slower (ICT-FaceKit's template: 464 ms against 63 ms;
-//    even into a bare TriMesh without UVs, 150 ms): two passes, a
+//  - its reader is 5-9x slower (ICT-FaceKit's template: 298 ms against 35 ms,
+//    and no faster into a bare TriMesh without UVs): two passes, a
 //    std::stringstream per line;
 //  - UVs come back per halfedge, so the file's `vt` numbering (and with it
 //    `uv_faces` and the UV count) is lost; its writer renumbers them, sorted

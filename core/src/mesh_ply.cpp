@@ -6,11 +6,11 @@
 // tega links (tega/core/openmesh.h), because:
 //  - OpenMesh reads MeshLab's per-face `texcoord` list only as a custom
 //    property (Options::Custom); without it, its reader misparses the face
-//    element and silently drops faces (2 of 2 faces in, 1 out);
+//    element: it drops faces (2 in, 1 out) or fails on a binary file;
 //  - the corner order of that list is only recoverable through where OpenMesh
 //    happens to start each face's halfedge loop;
-//  - its reader is slower (ICT-FaceKit's template: 109 ms against 59 ms;
-//    1M triangles: 1.30 s against 1.16 s; bench/mesh_io);
+//  - its reader is slower (ICT-FaceKit's template: 68 ms against 24 ms;
+//    1M triangles: 1.49 s against 1.27 s; bench/mesh_io);
 //  - it keeps no polygon numbers, refuses non-manifold faces by duplicating
 //    vertices, and reports errors as `false` plus a line on stderr.
 
