@@ -32,7 +32,8 @@ OpenMeshTriangles to_openmesh(const Mesh& mesh, const std::filesystem::path& sou
 Mesh from_openmesh(OpenMeshTriangles& mesh) {
   if (mesh.has_vertex_status() && mesh.has_edge_status() && mesh.has_face_status()) mesh.garbage_collection();
   Mesh result;
-  result.positions = Eigen::Map<const Vertices>(mesh.points()[0].data(), static_cast<Eigen::Index>(mesh.n_vertices()), 3);
+  result.positions = Eigen::Map<const Vertices>(reinterpret_cast<const float*>(mesh.points()),
+                                                static_cast<Eigen::Index>(mesh.n_vertices()), 3);
   result.faces.resize(static_cast<Eigen::Index>(mesh.n_faces()), 3);
   for (const auto face : mesh.faces()) {
     int k = 0;

@@ -146,6 +146,13 @@ TEST(MeshTools, SmallComponentsGoWithTheirVerticesAndTheRestKeepsUvsAndPolygons)
   EXPECT_EQ(largest.uv_faces, mesh.uv_faces.topRows(8));
 }
 
+TEST(MeshTools, EmptyMeshStaysEmpty) {
+  const Mesh empty;
+  EXPECT_EQ(decimate(empty, 10).num_vertices(), 0);
+  EXPECT_EQ(keep_largest_component(empty).num_faces(), 0);
+  EXPECT_TRUE(vertex_one_rings(empty).neighbours.empty());
+}
+
 TEST(MeshTools, NonManifoldInputNamesTheSourceAndTriangle) {
   // Three triangles on one edge.
   Mesh mesh;
