@@ -16,6 +16,14 @@ tega_require(yaml-cpp libyaml-cpp-dev)
 tega_require(spdlog libspdlog-dev)
 tega_require(CLI11 libcli11-dev)
 tega_require(PNG libpng-dev)
+# SHA-256 of the orchestrator's manifests (libcrypto's EVP interface).
+tega_require(OpenSSL libssl-dev)
+# OpenMesh: core's mesh tools (decimation, smoothing, adjacency,
+# components; tega/core/mesh_tools.h). Debian's config exports the targets
+# OpenMeshCore and OpenMeshTools with paths relative to the config file itself,
+# so an unpacked copy (scripts/gpu-carry: .carry/openmesh/usr) is found through
+# CMAKE_PREFIX_PATH or OpenMesh_DIR like the system one.
+tega_require(OpenMesh libopenmesh-dev CONFIG)
 find_package(Threads REQUIRED)
 
 # yaml-cpp 0.7 (Debian) exports "yaml-cpp"; newer releases "yaml-cpp::yaml-cpp".

@@ -1,5 +1,18 @@
 // Wavefront OBJ. The reader parses the whole file from memory with
 // std::from_chars: blendshape models load dozens of multi-megabyte OBJs.
+//
+// Written here rather than through OpenMesh's OBJ reader and writer, which
+// tega links (tega/core/openmesh.h), because OpenMesh cannot keep what tega's
+// meshes promise (docs/meshes-and-images.md, bench/mesh_io):
+//  - its reader is 5-9x slower (ICT-FaceKit's template: 298 ms against 35 ms,
+//    and no faster into a bare TriMesh without UVs): two passes, a
+//    std::stringstream per line;
+//  - UVs come back per halfedge, so the file's `vt` numbering (and with it
+//    `uv_faces` and the UV count) is lost; its writer renumbers them, sorted
+//    by value;
+//  - a face it cannot add (non-manifold) is retried on duplicated vertices,
+//    which changes the vertex count that .bin meshes and blendshapes rely on;
+//  - errors are a `false` and a line on stderr, not the file and line.
 
 #include <charconv>
 #include <limits>

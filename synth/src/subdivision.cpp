@@ -1,3 +1,21 @@
+// Midpoint (1-to-4, linear) subdivision that records, for every fine vertex,
+// its blend of coarse vertices; the Phong tessellation and the per-frame
+// positions are evaluated from those blends.
+//
+// Written here rather than with OpenMesh's subdividers (tega links OpenMesh,
+// tega/core/openmesh.h), because none of them fits:
+//  - LoopT, CompositeLoopT, Sqrt3T and CatmullClarkT are approximating: they
+//    move the coarse vertices and make each fine vertex a blend of a whole
+//    neighbourhood, not of one coarse triangle; ModifiedButterFlyT and the
+//    Labsik-Greiner scheme interpolate but blend up to ten vertices around an
+//    edge; MidpointT cuts corners (a face per original face and per original
+//    vertex, on edge midpoints only; the original vertices go);
+//    LongestEdgeT is adaptive. None records blend weights either.
+//  - A halfedge mesh has one UV per halfedge and no UV numbering, so the
+//    fine mesh's UV seams and `uv_faces` would have to be rebuilt afterwards,
+//    and a coarse mesh with a non-manifold piece would not convert at all.
+// Linear 1-to-4 midpoints that carry their weights take a page, below.
+
 #include <unordered_map>
 
 #include "tega/synth/fine_mesh.h"

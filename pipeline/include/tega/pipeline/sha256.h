@@ -1,12 +1,13 @@
 #pragma once
-// SHA-256 (FIPS 180-4) for the content hashes in shard manifests. Our own,
-// because OpenSSL is not among the dependencies every build machine has.
+// SHA-256 for the content hashes in shard manifests, through OpenSSL's EVP
+// interface (libcrypto; every build machine has it, the GPU machine included).
 
-#include <array>
-#include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <string_view>
+
+struct evp_md_ctx_st;  // OpenSSL's EVP_MD_CTX, kept out of this header
 
 namespace tega::pipeline {
 
@@ -17,12 +18,10 @@ class Sha256 {
   std::string hex_digest();  // finishes the hash; update() must not follow
 
  private:
-  void compress(const uint8_t* block);
-
-  std::array<uint32_t, 8> state_;
-  std::array<uint8_t, 64> buffer_{};
-  size_t buffered_ = 0;
-  uint64_t total_bytes_ = 0;
+  struct FreeContext {
+    void operator()(evp_md_ctx_st* context) const;
+  };
+  std::unique_ptr<evp_md_ctx_st, FreeContext> context_;
 };
 
 std::string sha256_hex(std::string_view bytes);
