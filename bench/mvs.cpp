@@ -83,11 +83,27 @@ void score_depth(const mvs::DepthMap& map, const ImageF& truth, DepthScore& scor
   }
 }
 
+#ifdef TEGA_BENCH_HAVE_MVS
+// The mesh against the frame's true fine mesh, over the face.
+void report_mesh(const Mesh& mesh, const fs::path& root, int frame) {
+  const mvs::StudioTruth truth = mvs::load_studio_truth(root, "expressions", frame);
+  mvs::EvaluationOptions eval;
+  eval.tolerances_m = {0.001, 0.002, 0.003};
+  const auto s = mvs::evaluate_surface(mesh, truth.fine, truth.face_region, eval);
+  std::printf("mesh: %d vertices, %d faces; accuracy median %.3f mm, mean %.3f mm, p90 %.3f mm; completeness over the "
+              "face %.1f %% at 1 mm, %.1f %% at 2 mm, %.1f %% at 3 mm\n",
+              mesh.num_vertices(), mesh.num_faces(), 1000 * s.accuracy_median_m, 1000 * s.accuracy_mean_m,
+              1000 * s.accuracy_p90_m, 100 * s.completeness[0], 100 * s.completeness[1], 100 * s.completeness[2]);
+}
+#endif
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"Multi-view stereo time and accuracy on one virtual-studio frame."};
-  int cameras = 13, width = 512, height = 384, frame = 0, threads = 0, window_radius = 0, window_step = 0;
+  int cameras = 13, width = 512, height = 384, frame = 0, threads = 0, window_radius = 0, window_step = 0,
+      fusion_step = 0;
+  std::string cloud_file;
   std::string device = "cpu", capture = (fs::temp_directory_path() / "tega-mvs-bench").string(), out, config;
   app.add_option("--cameras", cameras, "Cameras.");
   app.add_option("--width", width, "Image width.");
@@ -99,8 +115,11 @@ int main(int argc, char** argv) {
   app.add_option("--out", out, "Write the fused cloud (fused.ply) here, and the mesh (mesh.ply) where it is made.");
   app.add_option("--window-radius", window_radius, "PatchMatch window radius in pixels (default: the options').");
   app.add_option("--window-step", window_step, "PatchMatch window step in pixels (default: the options').");
+  app.add_option("--fusion-step", fusion_step, "Fuse every n-th pixel and row (default: the options').");
 #ifdef TEGA_BENCH_HAVE_MVS
   app.add_option("--config", config, "YAML whose `mvs` section sets the options.");
+  app.add_option("--cloud", cloud_file,
+                 "Mesh and score this fused cloud of the frame (e.g. one the GPU machine made) instead of making one.");
 #endif
   CLI11_PARSE(app, argc, argv);
 
@@ -114,11 +133,12 @@ int main(int argc, char** argv) {
   mvs::Options options;
   if (!config.empty()) load_options(options, config, "mvs");
   mvs::PatchMatchOptions pm = options.patch_match;
-  const mvs::FusionOptions fusion_options = options.fusion;
+  mvs::FusionOptions fusion_options = options.fusion;
 #else
   mvs::PatchMatchOptions pm;
-  const mvs::FusionOptions fusion_options;
+  mvs::FusionOptions fusion_options;
 #endif
+  if (fusion_step > 0) fusion_options.pixel_step = fusion_step;
   if (window_radius > 0) pm.window_radius = window_radius;
   if (window_step > 0) pm.window_step = window_step;
   if (device == "cuda" && !mvs::cuda_device_available()) {
@@ -126,6 +146,18 @@ int main(int argc, char** argv) {
     return 1;
   }
 
+#ifdef TEGA_BENCH_HAVE_MVS
+  if (!cloud_file.empty()) {
+    const mvs::OrientedPointCloud cloud = mvs::read_point_cloud_ply(cloud_file);
+    const auto start = Clock::now();
+    const Mesh mesh = mvs::reconstruct_surface(cloud, options.surface);
+    const double surface_s = seconds_since(start);
+    report_mesh(mesh, root, frame);
+    std::printf("%s: %d points; surface %.2f s on %d threads\n", cloud_file.c_str(), cloud.size(), surface_s,
+                options.surface.threads);
+    return 0;
+  }
+#endif
   auto start = Clock::now();
   std::vector<mvs::StereoView> views = loader.load(frame, pool);
 #ifdef TEGA_BENCH_HAVE_MVS
@@ -182,14 +214,7 @@ int main(int argc, char** argv) {
   start = Clock::now();
   const Mesh mesh = mvs::reconstruct_surface(cloud, options.surface);
   surface_s = seconds_since(start);
-  const mvs::StudioTruth truth = mvs::load_studio_truth(root, "expressions", frame);
-  mvs::EvaluationOptions eval;
-  eval.tolerances_m = {0.001, 0.002, 0.003};
-  const auto s = mvs::evaluate_surface(mesh, truth.fine, truth.face_region, eval);
-  std::printf("mesh: %d vertices, %d faces; accuracy median %.3f mm, mean %.3f mm, p90 %.3f mm; completeness over the "
-              "face %.1f %% at 1 mm, %.1f %% at 2 mm, %.1f %% at 3 mm\n",
-              mesh.num_vertices(), mesh.num_faces(), 1000 * s.accuracy_median_m, 1000 * s.accuracy_mean_m,
-              1000 * s.accuracy_p90_m, 100 * s.completeness[0], 100 * s.completeness[1], 100 * s.completeness[2]);
+  report_mesh(mesh, root, frame);
   if (!out.empty()) {
     fs::create_directories(out);
     write_mesh(mesh, fs::path(out) / "mesh.ply");

@@ -123,6 +123,7 @@ std::vector<FusedPoint> merge_voxels(const std::vector<FusedPoint>& points, doub
 OrientedPointCloud fuse_depth_maps(const std::vector<StereoView>& views, const std::vector<int>& map_views,
                                    const std::vector<DepthMap>& maps, const FusionOptions& options, ThreadPool* pool) {
   if (map_views.size() != maps.size()) throw Error("fusion: one view index per depth map is needed");
+  if (options.pixel_step < 1) throw Error("fusion: pixel_step must be at least 1");
   std::vector<MapView> inputs;
   for (size_t k = 0; k < maps.size(); ++k) {
     const StereoView& view = views.at(map_views[k]);
@@ -139,11 +140,12 @@ OrientedPointCloud fuse_depth_maps(const std::vector<StereoView>& views, const s
   std::vector<std::vector<FusedPoint>> rows;
   std::vector<FusedPoint> points;
   for (size_t r = 0; r < inputs.size(); ++r) {
-    const int width = inputs[r].map->width, height = inputs[r].map->height;
-    rows.assign(size_t(height), {});
-    pool->parallel_for(0, height, [&](int64_t y) {
-      for (int x = 0; x < width; ++x)
-        if (auto p = fuse_pixel(inputs, r, x, int(y), options, cos_max_angle)) rows[size_t(y)].push_back(*p);
+    const int width = inputs[r].map->width, height = inputs[r].map->height, step = options.pixel_step;
+    rows.assign(size_t((height + step - 1) / step), {});
+    pool->parallel_for(0, int64_t(rows.size()), [&](int64_t row) {
+      const int y = int(row) * step;
+      for (int x = 0; x < width; x += step)
+        if (auto p = fuse_pixel(inputs, r, x, y, options, cos_max_angle)) rows[size_t(row)].push_back(*p);
     });
     for (const auto& row : rows) points.insert(points.end(), row.begin(), row.end());
   }

@@ -2,6 +2,7 @@
 // that no other view confirms dropped.
 #include <gtest/gtest.h>
 
+#include "tega/core/error.h"
 #include "tega/mvs/fusion.h"
 
 namespace tega::mvs {
@@ -102,6 +103,19 @@ TEST(Fusion, VoxelsMergePoints) {
   const OrientedPointCloud merged = fuse_depth_maps(s.views, s.map_views, s.maps, o);
   EXPECT_LT(merged.size(), all / 3);
   for (int i = 0; i < merged.size(); ++i) ASSERT_NEAR(merged.points.row(i).cast<double>().norm(), kRadius, 1e-3);
+}
+
+TEST(Fusion, PixelStepTakesEveryNthPixel) {
+  const Scene s = sphere_scene();
+  FusionOptions o;
+  o.voxel_size_m = 0;
+  const int all = fuse_depth_maps(s.views, s.map_views, s.maps, o).size();
+  o.pixel_step = 2;
+  const OrientedPointCloud sparse = fuse_depth_maps(s.views, s.map_views, s.maps, o);
+  EXPECT_NEAR(double(sparse.size()) / all, 0.25, 0.03);
+  for (int i = 0; i < sparse.size(); ++i) ASSERT_NEAR(sparse.points.row(i).cast<double>().norm(), kRadius, 2e-4);
+  o.pixel_step = 0;
+  EXPECT_THROW(fuse_depth_maps(s.views, s.map_views, s.maps, o), Error);
 }
 
 }  // namespace

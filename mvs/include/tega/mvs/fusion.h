@@ -22,6 +22,7 @@ struct FusionOptions {
   float max_reprojection_px = 1.0f;   // forward-backward reprojection in the reference view
   float max_normal_angle_deg = 25.0f;
   double voxel_size_m = 0.0004;       // points within one voxel merge (0: no merging)
+  int pixel_step = 1;                 // fuse every pixel_step-th pixel of every pixel_step-th row
 
   template <class V>
   void visit(V& v) {
@@ -30,6 +31,8 @@ struct FusionOptions {
     v("max_reprojection_px", max_reprojection_px, "Largest forward-backward reprojection error of a confirmation, pixels.");
     v("max_normal_angle_deg", max_normal_angle_deg, "Largest angle between the normals of a confirmation, degrees.");
     v("voxel_size_m", voxel_size_m, "Points within one voxel of this size merge into one (0: keep all), metres.");
+    v("pixel_step", pixel_step,
+      "Fuse every pixel_step-th pixel and row: at high resolution several pixels fall in one voxel anyway.");
   }
 };
 
