@@ -102,7 +102,7 @@ void report_mesh(const Mesh& mesh, const fs::path& root, int frame) {
 int main(int argc, char** argv) {
   CLI::App app{"Multi-view stereo time and accuracy on one virtual-studio frame."};
   int cameras = 13, width = 512, height = 384, frame = 0, threads = 0, window_radius = 0, window_step = 0,
-      fusion_step = 0;
+      fusion_step = 0, iterations = 0, geometric_iterations = 0;
   std::string cloud_file;
   std::string device = "cpu", capture = (fs::temp_directory_path() / "tega-mvs-bench").string(), out, config;
   app.add_option("--cameras", cameras, "Cameras.");
@@ -116,6 +116,8 @@ int main(int argc, char** argv) {
   app.add_option("--window-radius", window_radius, "PatchMatch window radius in pixels (default: the options').");
   app.add_option("--window-step", window_step, "PatchMatch window step in pixels (default: the options').");
   app.add_option("--fusion-step", fusion_step, "Fuse every n-th pixel and row (default: the options').");
+  app.add_option("--iterations", iterations, "Photometric PatchMatch iterations (default: the options').");
+  app.add_option("--geometric-iterations", geometric_iterations, "Geometric iterations (default: the options').");
 #ifdef TEGA_BENCH_HAVE_MVS
   app.add_option("--config", config, "YAML whose `mvs` section sets the options.");
   app.add_option("--cloud", cloud_file,
@@ -139,6 +141,8 @@ int main(int argc, char** argv) {
   mvs::FusionOptions fusion_options;
 #endif
   if (fusion_step > 0) fusion_options.pixel_step = fusion_step;
+  if (iterations > 0) pm.iterations = iterations;
+  if (geometric_iterations > 0) pm.geometric_iterations = geometric_iterations;
   if (window_radius > 0) pm.window_radius = window_radius;
   if (window_step > 0) pm.window_step = window_step;
   if (device == "cuda" && !mvs::cuda_device_available()) {

@@ -9,8 +9,8 @@
 namespace tega::synth {
 namespace {
 
-const std::filesystem::path kStudio13 =
-    std::filesystem::path(__FILE__).parent_path() / "../../studio_configs/studio13.yaml";
+// Not through __FILE__: ccache's base_dir makes it relative to the build folder.
+const std::filesystem::path kStudio13 = std::filesystem::path(TEGA_STUDIO_CONFIGS) / "studio13.yaml";
 
 TEST(StudioRig, Studio13ConfigEqualsTheDefaults) {
   Options from_file;
