@@ -316,6 +316,18 @@ TEST(TegaRun, MeshesEveryPerformanceFrameWithTheCalibratedRig) {
     EXPECT_GT(read_mesh(mesh).num_faces(), 1000);
   }
   EXPECT_FALSE(fs::exists(dir / "ws/mvs/default/.resume-key"));
+
+  // As if a run had been killed after both frames: a staging directory with
+  // the frames and the shard's key. Run again, the frames are kept.
+  const fs::path staging = dir / "ws/mvs/.staging-default";
+  fs::create_directories(staging);
+  fs::copy(dir / "ws/mvs/default/meshes", staging / "meshes", fs::copy_options::recursive);
+  const json manifest = json::parse(read_text_file(dir / "ws/mvs/default/manifest.json"));
+  write_text(staging / ".resume-key", manifest["key"].get<std::string>());
+  const auto resumed = run_tega({"run", (dir / "studio.yaml").string(), "--force", "mvs"}, dir.path());
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  const std::string log = read_text_file(dir / "ws/logs/mvs/default.log");
+  EXPECT_NE(log.find("0 frame(s) meshed, 2 already done"), std::string::npos) << log;
 }
 
 TEST(TegaRun, TheShippedConfigsAreValidGraphs) {

@@ -47,6 +47,8 @@ void Workspace::remove_leftovers(const std::vector<std::string>& stages) const {
     if (!fs::is_directory(folder)) continue;
     for (const auto& entry : fs::directory_iterator(folder)) {
       const std::string name = entry.path().filename().string();
+      // A resumable shard's partial outputs stay; its launch keeps them only for the same fingerprint.
+      if (name.rfind(kStagingPrefix, 0) == 0 && fs::exists(entry.path() / kResumeKeyFile)) continue;
       if (name.rfind(kStagingPrefix, 0) == 0 || name.rfind(kReplacedPrefix, 0) == 0) remove_tree(entry.path());
     }
   }
