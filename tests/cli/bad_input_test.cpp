@@ -35,6 +35,18 @@ TEST(CliBadInput, FileThatIsNotAnImageIsNamed) {
   EXPECT_NE(r.output.find(image.string() + ": is not a PNG image"), std::string::npos) << r.output;
 }
 
+TEST(CliBadInput, MvsOnAMissingCaptureNamesIt) {
+  tega::test::TempDir tmp;
+  const auto r = run_tega("mvs --capture " + (tmp / "nowhere").string() + " --out " + (tmp / "meshes").string());
+  if (r.output.find("could not be matched") != std::string::npos) GTEST_SKIP() << "this build has no tega mvs";
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find((tmp / "nowhere").string()), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(tmp / "meshes"));
+  const auto frames = run_tega("mvs --capture x --out y --frames 9:3");
+  EXPECT_EQ(frames.exit_code, 1) << frames.output;
+  EXPECT_NE(frames.output.find("--frames '9:3'"), std::string::npos) << frames.output;
+}
+
 TEST(CliRigConvert, KrtToJsonToColmapInMetres) {
   tega::test::TempDir tmp;
   tega::test::write_text(tmp / "KRT",
