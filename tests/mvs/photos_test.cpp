@@ -9,6 +9,7 @@
 #include "tega/mvs/reconstruction.h"
 #include "tega/mvs/studio_truth.h"
 #include "tega/synth/virtual_studio.h"
+#include "small_studio.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -34,16 +35,7 @@ double completeness_at_3mm(const Mesh& mesh, const StudioTruth& truth, double& m
 
 TEST(MvsPhotos, AColmapRiggedPhotoSetAndItsWorkspaceMeshTheFace) {
   const test::TempDir dir;
-  synth::Options o;
-  o.studio.cameras = 7;
-  o.studio.width = 320;
-  o.studio.height = 240;
-  o.frames = 1;
-  o.calibration_frames = 0;
-  o.takes = {"expressions"};
-  o.test_takes = {};
-  o.test_cameras = 1;
-  synth::render_virtual_studio(o, dir / "capture");
+  synth::render_virtual_studio(test::small_studio(7, 320, 240, 1), dir / "capture");
   const Rig rig = read_rig_json(dir / "capture" / "rig.json");
   write_colmap_text(rig, dir / "sparse");
   fs::create_directories(dir / "photos");

@@ -12,6 +12,7 @@
 #include "tega/mvs/reconstruction.h"
 #include "tega/mvs/studio_truth.h"
 #include "tega/synth/virtual_studio.h"
+#include "small_studio.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -22,13 +23,7 @@ namespace {
 const fs::path& studio_capture() {
   static const test::TempDir dir;
   static const fs::path root = [] {
-    synth::Options o;
-    o.frames = 2;
-    o.calibration_frames = 0;
-    o.takes = {"expressions"};
-    o.test_takes = {};
-    o.test_cameras = 1;
-    synth::render_virtual_studio(o, dir / "capture");
+    synth::render_virtual_studio(test::small_studio(13, 512, 384, 2), dir / "capture");
     return dir / "capture";
   }();
   return root;

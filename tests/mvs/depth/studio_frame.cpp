@@ -11,6 +11,7 @@
 #include "tega/mvs/view_selection.h"
 #include "tega/synth/ground_truth_depth.h"
 #include "tega/synth/virtual_studio.h"
+#include "small_studio.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -20,17 +21,8 @@ namespace {
 
 StudioFrame render_frame() {
   const TempDir dir;
-  synth::Options o;
-  o.studio.cameras = 7;
-  o.studio.width = 320;
-  o.studio.height = 240;
-  o.frames = 1;
-  o.calibration_frames = 0;
-  o.takes = {"expressions"};
-  o.test_takes = {};
-  o.test_cameras = 1;
   const fs::path root = dir / "capture";
-  synth::render_virtual_studio(o, root);
+  synth::render_virtual_studio(small_studio(7, 320, 240, 1), root);
 
   StudioFrame frame;
   ThreadPool pool(0);
