@@ -20,7 +20,8 @@ struct FaceComponents {
 };
 
 FaceComponents face_components(const Mesh& mesh, const std::filesystem::path& source) {
-  const OpenMeshTriangles connectivity = to_openmesh(mesh, source);
+  // A triangle that joins its neighbours non-manifoldly is its own component.
+  const OpenMeshTriangles connectivity = to_openmesh(mesh, source, NonManifold::detach);
   FaceComponents components;
   components.of_face.assign(connectivity.n_faces(), -1);
   std::vector<OpenMeshTriangles::FaceHandle> pending;

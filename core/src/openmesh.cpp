@@ -1,5 +1,6 @@
 #include "tega/core/openmesh.h"
 
+#include <OpenMesh/Core/System/omstream.hh>
 #include <string>
 
 #include "tega/core/error.h"
@@ -9,8 +10,18 @@ namespace tega {
 static_assert(sizeof(OpenMeshTriangles::Point) == 3 * sizeof(float),
               "OpenMesh points are copied to and from Vertices as flat float arrays");
 
-OpenMeshTriangles to_openmesh(const Mesh& mesh, const std::filesystem::path& source) {
+OpenMeshTriangles to_openmesh(const Mesh& mesh, const std::filesystem::path& source, NonManifold non_manifold) {
   mesh.validate(source);
+  // Refused triangles are reported here (naming the file) or detached on purpose:
+  // OpenMesh's own complaints on stderr would only repeat or contradict that.
+  const bool was_enabled = omerr().is_enabled();
+  omerr().disable();
+  struct Restore {
+    bool enable;
+    ~Restore() {
+      if (enable) omerr().enable();
+    }
+  } restore{was_enabled};
   OpenMeshTriangles result;
   result.reserve(mesh.positions.rows(), 3 * mesh.faces.rows(), mesh.faces.rows());
   for (Eigen::Index v = 0; v < mesh.positions.rows(); ++v) {
@@ -20,6 +31,12 @@ OpenMeshTriangles to_openmesh(const Mesh& mesh, const std::filesystem::path& sou
     const OpenMeshTriangles::FaceHandle face =
         result.add_face(result.vertex_handle(mesh.faces(f, 0)), result.vertex_handle(mesh.faces(f, 1)),
                         result.vertex_handle(mesh.faces(f, 2)));
+    if (!face.is_valid() && non_manifold == NonManifold::detach) {
+      // add_face has complained on OpenMesh's error stream; the copies settle it.
+      OpenMeshTriangles::VertexHandle copies[3];
+      for (int k = 0; k < 3; ++k) copies[k] = result.add_vertex(result.point(result.vertex_handle(mesh.faces(f, k))));
+      if (result.add_face(copies[0], copies[1], copies[2]).is_valid()) continue;
+    }
     if (!face.is_valid()) {
       throw Error(source, "triangle " + std::to_string(f) + " (" + std::to_string(mesh.faces(f, 0)) + " " +
                               std::to_string(mesh.faces(f, 1)) + " " + std::to_string(mesh.faces(f, 2)) +

@@ -7,8 +7,10 @@
 #include <open3d/utility/Logging.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "tega/core/error.h"
+#include "tega/core/mesh_tools.h"
 
 namespace tega::mvs {
 namespace {
@@ -54,14 +56,11 @@ void trim_far_from_points(open3d::geometry::TriangleMesh& mesh, const open3d::ge
   mesh.RemoveTrianglesByMask(remove);
 }
 
-void trim_small_components(open3d::geometry::TriangleMesh& mesh, double min_share) {
-  if (min_share <= 0 || mesh.triangles_.empty()) return;
-  const auto [component, faces_per_component, area] = mesh.ClusterConnectedTriangles();
-  const size_t largest = *std::max_element(faces_per_component.begin(), faces_per_component.end());
-  std::vector<bool> remove(component.size());
-  for (size_t f = 0; f < component.size(); ++f)
-    remove[f] = double(faces_per_component[size_t(component[f])]) < min_share * double(largest);
-  mesh.RemoveTrianglesByMask(remove);
+// Through core's mesh tools (OpenMesh), which tracking shares.
+Mesh trim_small_components(const Mesh& mesh, double min_share) {
+  if (min_share <= 0 || mesh.num_faces() == 0) return mesh;
+  const int largest = keep_largest_component(mesh, "the Poisson surface").num_faces();
+  return remove_small_components(mesh, int(std::ceil(min_share * largest)), "the Poisson surface");
 }
 
 // Poisson's winding follows the normals it was given, but its convention is
@@ -110,10 +109,9 @@ Mesh reconstruct_surface(const OrientedPointCloud& cloud, const SurfaceOptions& 
   const open3d::geometry::KDTreeFlann tree(points);
   trim_low_density(*mesh, densities, options.trim_density_quantile);
   trim_far_from_points(*mesh, tree, options.trim_distance_m);
-  trim_small_components(*mesh, options.min_component_share);
   mesh->RemoveUnreferencedVertices();
   orient_like_points(*mesh, points, tree);
-  return to_tega(*mesh);
+  return trim_small_components(to_tega(*mesh), options.min_component_share);
 }
 
 }  // namespace tega::mvs

@@ -168,5 +168,19 @@ TEST(MeshTools, NonManifoldInputNamesTheSourceAndTriangle) {
   }
 }
 
+TEST(MeshTools, ATriangleOnAFullEdgeIsItsOwnComponent) {
+  // Three triangles on one edge, as trimmed Poisson surfaces have: the first
+  // two hold the edge, the third is detached.
+  Mesh mesh;
+  mesh.positions.resize(5, 3);
+  mesh.positions << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1;
+  mesh.faces.resize(3, 3);
+  mesh.faces << 0, 1, 2, 1, 0, 3, 0, 1, 4;
+  const Mesh kept = remove_small_components(mesh, 2, "scan.ply");
+  ASSERT_EQ(kept.num_faces(), 2);
+  EXPECT_EQ(kept.num_vertices(), 4);
+  EXPECT_EQ(keep_largest_component(mesh).num_faces(), 2);
+}
+
 }  // namespace
 }  // namespace tega

@@ -20,6 +20,7 @@ namespace {
 Options quick_options() {
   Options o;
   o.device = "cpu";
+  o.surface.threads = 1;  // OpenMP's spinning threads stall beside other tests
   o.patch_match.iterations = 3;
   o.patch_match.geometric_iterations = 1;
   return o;

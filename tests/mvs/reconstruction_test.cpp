@@ -29,9 +29,12 @@ const fs::path& studio_capture() {
   return root;
 }
 
+// One thread for Poisson: OpenMP's spinning threads stall when ctest runs
+// other tests beside this one on a small machine.
 Options cpu_options() {
   Options o;
   o.device = "cpu";
+  o.surface.threads = 1;
   return o;
 }
 

@@ -305,7 +305,7 @@ TEST(TegaRun, MeshesEveryPerformanceFrameWithTheCalibratedRig) {
              "      frames: 2\n      takes: [speech]\n      test_takes: []\n      write_fine_meshes: false\n"
              "  calibrate: {after: synth, options: {board: board.yaml}}\n"
              "  mvs:\n    after: calibrate\n    options:\n      device: cpu\n"
-             "      patch_match: {iterations: 3, geometric_iterations: 1}\n");
+             "      patch_match: {iterations: 3, geometric_iterations: 1}\n      surface: {threads: 1}\n");
   const auto r = run_tega({"run", (dir / "studio.yaml").string()}, dir.path());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const json status = status_json(dir / "ws", dir.path());

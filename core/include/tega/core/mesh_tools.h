@@ -37,7 +37,9 @@ Vertices smooth_laplacian(const Mesh& mesh, int iterations, const std::filesyste
 Mesh decimate(const Mesh& mesh, int target_faces, const std::filesystem::path& source = "mesh");
 
 // Drops connected components (faces joined by edges) of fewer than
-// `min_faces` triangles, and the vertices only they used. What stays keeps its
+// `min_faces` triangles, and the vertices only they used. A triangle that
+// joins its neighbours non-manifoldly (a third one on an edge) counts as a
+// component of its own. What stays keeps its
 // order, UVs and polygon numbers; vertices are renumbered compactly.
 Mesh remove_small_components(const Mesh& mesh, int min_faces, const std::filesystem::path& source = "mesh");
 // Keeps only the component with the most triangles (the first such one on a tie).

@@ -18,11 +18,18 @@ namespace tega {
 
 using OpenMeshTriangles = OpenMesh::TriMesh_ArrayKernelT<>;
 
+// What to do with a triangle a halfedge mesh cannot hold (a third triangle on
+// an edge, a vertex joining two fans): `reject` throws tega::Error naming
+// `source` and the triangle; `detach` adds it on copies of its vertices
+// (appended after the mesh's own), as OpenMesh's own readers do, so it keeps
+// its face handle but touches none of its neighbours. Reconstructed surfaces
+// (Poisson, then trimmed) have such triangles.
+enum class NonManifold { reject, detach };
+
 // Vertex v becomes vertex handle v and triangle f face handle f. UVs and
-// polygon numbers are not carried. Throws tega::Error naming `source` when a
-// triangle cannot be added: a non-manifold edge or vertex, which a halfedge
-// mesh cannot represent.
-OpenMeshTriangles to_openmesh(const Mesh& mesh, const std::filesystem::path& source);
+// polygon numbers are not carried.
+OpenMeshTriangles to_openmesh(const Mesh& mesh, const std::filesystem::path& source,
+                              NonManifold non_manifold = NonManifold::reject);
 
 // Positions and triangles of the live elements, in handle order; elements
 // marked deleted (e.g. by decimation) are collected away first. No UVs.

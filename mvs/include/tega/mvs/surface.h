@@ -18,7 +18,7 @@ struct SurfaceOptions {
   double trim_distance_m = 0.003;
   // Connected components with fewer faces than this share of the largest are removed.
   double min_component_share = 0.05;
-  int threads = 0;  // 0: one per hardware thread
+  int threads = 0;  // 0: one per hardware thread (OpenMP: on a busy machine, fewer is faster)
 
   template <class V>
   void visit(V& v) {
