@@ -59,9 +59,13 @@ void check_input(const std::vector<StereoView>& views, const std::vector<ViewTas
       throw Error("patch match: view " + c.name + ": its mask does not have one value per pixel");
     if (c.has_distortion()) throw Error("patch match: view " + c.name + ": the camera must be undistorted");
   }
+  std::vector<bool> referenced(views.size(), false);
   for (const auto& task : tasks) {
     const auto valid = [&](int v) { return v >= 0 && v < static_cast<int>(views.size()); };
     if (!valid(task.reference)) throw Error("patch match: a task's reference view is out of range");
+    if (referenced[size_t(task.reference)])
+      throw Error("patch match: view " + views[task.reference].camera.name + " is the reference of two tasks");
+    referenced[size_t(task.reference)] = true;
     if (task.sources.empty())
       throw Error("patch match: view " + views[task.reference].camera.name + " has no source view");
     if (static_cast<int>(task.sources.size()) > detail::kMaxSources)

@@ -103,6 +103,9 @@ TEST(PatchMatch, BadInputIsNamed) {
   tasks[0].depth_min = tasks[0].depth_max;
   EXPECT_THROW(estimate_depth_maps(frame.views, tasks, quick_options(), Device::cpu, &pool), Error);
   tasks = frame.tasks;
+  tasks[1] = tasks[0];
+  EXPECT_THROW(estimate_depth_maps(frame.views, tasks, quick_options(), Device::cpu, &pool), Error);
+  tasks = frame.tasks;
   tasks[0].sources = {tasks[0].reference};
   EXPECT_THROW(estimate_depth_maps(frame.views, tasks, quick_options(), Device::cpu, &pool), Error);
   PatchMatchOptions wide = quick_options();
