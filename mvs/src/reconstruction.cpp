@@ -90,16 +90,14 @@ FrameReconstruction reconstruct_views(const std::vector<StereoView>& views, cons
 
   std::vector<Camera> cameras;
   for (int k : seeing) cameras.push_back(views[k].camera);
-  std::optional<Eigen::Vector3d> focus;
-  if (options.depth_range_m.empty()) {
-    focus = rig_focus_point(cameras);
-    if (!focus)
-      throw Error(label + ": the cameras do not aim at a common point (" + camera_list(views, seeing) +
-                  "); give depth_range_m");
-  } else if (options.depth_range_m.size() != 2 || !(options.depth_range_m[0] > 0) ||
-             !(options.depth_range_m[1] > options.depth_range_m[0])) {
+  const std::optional<Eigen::Vector3d> focus = rig_focus_point(cameras);
+  const bool given_range = !options.depth_range_m.empty();
+  if (!given_range && !focus)
+    throw Error(label + ": the cameras do not aim at a common point (" + camera_list(views, seeing) +
+                "); give depth_range_m");
+  if (given_range && (options.depth_range_m.size() != 2 || !(options.depth_range_m[0] > 0) ||
+                      !(options.depth_range_m[1] > options.depth_range_m[0])))
     throw Error("mvs: depth_range_m must be [min, max] with 0 < min < max");
-  }
   const auto ranked = focus ? select_source_views(cameras, *focus, options.patch_match.source_views)
                             : select_source_views_by_axes(cameras, options.patch_match.source_views);
 
@@ -114,7 +112,7 @@ FrameReconstruction reconstruct_views(const std::vector<StereoView>& views, cons
     ViewTask task;
     task.reference = seeing[k];
     for (int s : ranked[k]) task.sources.push_back(seeing[s]);
-    if (focus) {
+    if (!given_range) {
       const double centre = cameras[k].world_to_camera.apply(*focus).z();
       task.depth_min = float(std::max(centre - options.subject_radius_m, 0.05 * centre));
       task.depth_max = float(centre + options.subject_radius_m);
