@@ -100,6 +100,15 @@ else()
   message(STATUS "tega: Open3D not found (libopen3d-dev): mvs/ builds its depth estimation only")
 endif()
 
+# dlib: 68-point landmark predictors for tracking/.
+set(TEGA_HAVE_DLIB OFF)
+find_package(dlib QUIET)
+if(dlib_FOUND)
+  set(TEGA_HAVE_DLIB ON)
+else()
+  message(STATUS "tega: dlib not found (libdlib-dev): tracking/ is off")
+endif()
+
 # nvcc compiles the kernels of avatar/ and of mvs/'s depth estimation; no GPU
 # is needed to build them.
 set(TEGA_HAVE_CUDA OFF)

@@ -68,6 +68,23 @@ std::optional<Eigen::Vector2d> Camera::project(const Eigen::Vector3d& world) con
   return normalised_to_pixel(K, distort(c.head<2>() / c.z()));
 }
 
+Eigen::Matrix<double, 2, 3> Camera::projection_jacobian(const Eigen::Vector3d& world) const {
+  const Eigen::Vector3d c = world_to_camera.apply(world);
+  const double x = c.x() / c.z(), y = c.y() / c.z();
+  Eigen::Matrix<double, 2, 3> normalised_by_camera;
+  normalised_by_camera << 1 / c.z(), 0, -x / c.z(), 0, 1 / c.z(), -y / c.z();
+  const auto [k1, k2, p1, p2, k3] = distortion;
+  const double r2 = x * x + y * y;
+  const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  const double radial_by_r2 = k1 + r2 * (2 * k2 + 3 * r2 * k3);
+  Eigen::Matrix2d distorted_by_normalised;
+  distorted_by_normalised << radial + 2 * x * x * radial_by_r2 + 2 * p1 * y + 6 * p2 * x,
+      2 * x * y * radial_by_r2 + 2 * p1 * x + 2 * p2 * y,  //
+      2 * x * y * radial_by_r2 + 2 * p1 * x + 2 * p2 * y,
+      radial + 2 * y * y * radial_by_r2 + 6 * p1 * y + 2 * p2 * x;
+  return K.topLeftCorner<2, 2>() * distorted_by_normalised * normalised_by_camera * world_to_camera.R;
+}
+
 Eigen::Vector3d Camera::unproject(const Eigen::Vector2d& pixel, double depth) const {
   const Eigen::Vector2d p = undistort(pixel_to_normalised(K, pixel));
   return world_to_camera.inverse().apply(Eigen::Vector3d(p.x() * depth, p.y() * depth, depth));

@@ -77,8 +77,11 @@ void validate_options(const Options& o) {
 }
 
 Head make_head(const Options& o) {
-  if (o.head.empty()) return make_procedural_head();
-  return load_head(o.head, o.head_metres_per_unit, o.head_eyeball_polygons);
+  Head head = o.head.empty() ? make_procedural_head()
+                             : load_head(o.head, o.head_metres_per_unit, o.head_eyeball_polygons);
+  if (!o.head_identity.empty() || o.head_shape_detail_m > 0)
+    make_subject(head, o.head_identity, o.head_shape_detail_m, uint64_t(o.seed));
+  return head;
 }
 
 SynthSummary render_virtual_studio(const Options& o, const std::filesystem::path& out, bool replace_existing) {

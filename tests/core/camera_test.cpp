@@ -69,6 +69,20 @@ TEST(Camera, UnprojectInvertsProject) {
   }
 }
 
+TEST(Camera, ProjectionJacobianMatchesCentralDifferences) {
+  const Camera c = studio_camera();
+  const double h = 1e-6;
+  for (const Eigen::Vector3d& p : visible_points(c, 200)) {
+    const Eigen::Matrix<double, 2, 3> analytic = c.projection_jacobian(p);
+    Eigen::Matrix<double, 2, 3> numeric;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d step = h * Eigen::Vector3d::Unit(k);
+      numeric.col(k) = (*c.project(p + step) - *c.project(p - step)) / (2 * h);
+    }
+    EXPECT_LT((analytic - numeric).norm(), 1e-4 * numeric.norm()) << p.transpose();
+  }
+}
+
 TEST(Camera, ProjectThenUnprojectRecoversWorldPoint) {
   const Camera c = studio_camera();
   std::mt19937 rng(4);

@@ -42,6 +42,9 @@ struct Camera {
   // World point -> pixel, with distortion. nullopt when the point is not in
   // front of the camera (z <= 0). The pixel may lie outside the image.
   std::optional<Eigen::Vector2d> project(const Eigen::Vector3d& world) const;
+  // d project(world) / d world, analytic (distortion included), for
+  // Gauss-Newton solvers. Requires the point in front of the camera.
+  Eigen::Matrix<double, 2, 3> projection_jacobian(const Eigen::Vector3d& world) const;
   // Pixel + depth along the camera's z axis -> world point (inverse of project()).
   Eigen::Vector3d unproject(const Eigen::Vector2d& pixel, double depth) const;
   // Unit-length world-space direction of the ray through a (distorted) pixel.

@@ -7,6 +7,7 @@
 // Head space follows ICT-FaceKit and OBJ habits: metres, +y up, the face
 // looks along +z, +x is the subject's left (ARKit's "_L").
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -69,6 +70,14 @@ Head make_procedural_head();
 // Throws tega::Error naming the directory when the eyeballs are unknown.
 Head load_head(const std::filesystem::path& directory, double metres_per_unit,
                const std::vector<int>& eyeball_polygons);
+
+// Makes the head a particular subject: the model's identity shapes weighted
+// by `identity`, plus, when detail_m > 0, a smooth seeded displacement along
+// the skin's normals (bumps of a few centimetres, the largest detail_m high)
+// that lies outside the model's span. Eyeballs keep their shape. The model's
+// neutral becomes the subject's; its shapes stay as they are. Throws
+// tega::Error for more coefficients than identity shapes.
+void make_subject(Head& head, const std::vector<double>& identity, double detail_m, uint64_t seed);
 
 // Fills triangle_eye, frame, pivot and the default wrinkle regions from the
 // model and eyeball_faces.

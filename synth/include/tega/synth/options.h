@@ -49,6 +49,8 @@ struct Options {
   std::string head;
   double head_metres_per_unit = 0.01;
   std::vector<int> head_eyeball_polygons;
+  std::vector<double> head_identity;
+  double head_shape_detail_m = 0.0;
   std::vector<std::string> takes = {"expressions", "speech", "freestyle"};
   std::vector<std::string> test_takes = {"freestyle"};
   int test_cameras = 2;
@@ -75,6 +77,12 @@ struct Options {
     v("head_eyeball_polygons", head_eyeball_polygons,
       "First and last polygon index of the `head` model's eyeballs; empty = ICT-FaceKit's "
       "[21496, 24691] when the model has ICT-FaceKit's topology.");
+    v("head_identity", head_identity,
+      "Coefficients of the head model's identity shapes that make the subject (missing ones are 0; "
+      "empty = the model's neutral head).");
+    v("head_shape_detail_m", head_shape_detail_m,
+      "Largest offset, metres, of a smooth shape detail added along the skin's normals that no "
+      "combination of the model's shapes can express (0 = none): a subject the model only approximates.");
     v("takes", takes, "Performance takes to render, by script name: expressions, speech, freestyle.");
     v("test_takes", test_takes, "Performance takes whose frames form the dataset's test split.");
     v("test_cameras", test_cameras,

@@ -1,0 +1,64 @@
+#pragma once
+// 2D facial landmarks from a user-supplied dlib 68-point shape predictor
+// (the Multi-PIE markup of dlib's shape_predictor_68_face_landmarks.dat, or
+// one trained with train_landmark_predictor). No landmark model ships with
+// tega: tracking works without one, and uses one when it is configured.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "tega/core/image.h"
+
+namespace tega::tracking {
+
+constexpr int kLandmarkCount = 68;
+
+// A face's bounding box in pixels: min = top-left, max = bottom-right.
+using FaceBox = Eigen::AlignedBox2d;
+
+class LandmarkDetector {
+ public:
+  // Throws tega::Error naming the file when it is missing or not a dlib
+  // shape predictor with 68 parts.
+  explicit LandmarkDetector(const std::filesystem::path& model);
+  ~LandmarkDetector();
+  LandmarkDetector(const LandmarkDetector&) = delete;
+  LandmarkDetector& operator=(const LandmarkDetector&) = delete;
+
+  // The 68 landmarks (pixels, dlib's order) of the face in `box`, or, with
+  // no box, of the largest face dlib's frontal face detector finds (nullopt
+  // when it finds none). `image`: 8-bit RGB or grey. Thread-safe.
+  std::optional<std::vector<Eigen::Vector2d>> detect(const Image8& image, const std::optional<FaceBox>& box) const;
+
+ private:
+  struct Model;
+  std::unique_ptr<Model> model_;
+};
+
+// One training image: a face, its box and its 68 landmarks (pixels).
+struct LandmarkSample {
+  Image8 image;
+  FaceBox box;
+  std::vector<Eigen::Vector2d> landmarks;
+};
+
+struct LandmarkTrainingOptions {
+  int cascade_depth = 10;
+  int tree_depth = 4;
+  int trees_per_cascade_level = 200;
+  int oversampling = 20;
+  double nu = 0.1;
+  int threads = 0;  // 0: one per hardware thread
+};
+
+// Trains a dlib shape predictor (dlib's shape_predictor_trainer) on the
+// samples and writes it to `out` (atomically) in the format
+// LandmarkDetector reads. Throws tega::Error for samples without 68 landmarks.
+void train_landmark_predictor(const std::vector<LandmarkSample>& samples, const LandmarkTrainingOptions& options,
+                              const std::filesystem::path& out);
+
+}  // namespace tega::tracking

@@ -1,0 +1,160 @@
+#pragma once
+// Options of template tracking (`tega track`, docs/tracking.md). Every term
+// of the energy is a group of residuals, each divided by its `sigma` (the
+// error one expects of a good fit) and the group scaled by
+// sqrt(weight / count), so a weight is the term's share of the energy
+// whatever the number of vertices, views or landmarks behind it.
+
+#include <string>
+#include <vector>
+
+namespace tega::tracking {
+
+// Point-to-plane distances from the model's fit vertices to the frame's
+// multi-view stereo mesh (non-rigid ICP).
+struct SurfaceTermOptions {
+  double sigma_m = 0.0005;
+  double weight = 1.0;
+  double max_distance_m = 0.01;      // correspondences farther than this are dropped
+  double final_distance_m = 0.003;   // ... the bound shrinks to this over the ICP iterations
+  double max_normal_angle_deg = 60;  // ... and so are those whose normals disagree more
+  double robust_scale = 3.0;         // Cauchy loss scale, in sigmas
+
+  template <class V>
+  void visit(V& v) {
+    v("sigma_m", sigma_m, "Expected point-to-plane distance of a good fit, metres.");
+    v("weight", weight, "Share of the energy of the surface term.");
+    v("max_distance_m", max_distance_m, "Correspondences farther than this are dropped at the first ICP iteration.");
+    v("final_distance_m", final_distance_m, "... and farther than this at the last (the bound shrinks linearly).");
+    v("max_normal_angle_deg", max_normal_angle_deg,
+      "Correspondences whose surface normals differ by more than this are dropped, degrees.");
+    v("robust_scale", robust_scale, "Scale of the Cauchy loss, in sigmas: larger residuals count less.");
+  }
+};
+
+// Image terms: where vertices must project in each camera.
+struct ImageTermOptions {
+  double sigma_px = 1.0;
+  double weight = 0.5;
+  double robust_scale = 3.0;
+
+  template <class V>
+  void visit(V& v) {
+    v("sigma_px", sigma_px, "Expected reprojection error of a good fit, pixels of the captured image.");
+    v("weight", weight, "Share of the energy of the term.");
+    v("robust_scale", robust_scale, "Scale of the Cauchy loss, in sigmas.");
+  }
+};
+
+// Multi-view optical flow between consecutive frames (OpenCV's DIS),
+// back-projected through the rig, so that the surface does not slide.
+struct FlowOptions {
+  bool enabled = true;
+  ImageTermOptions term{1.0, 0.5, 3.0};
+  double max_forward_backward_px = 1.0;  // flow whose round trip misses by more is not trusted
+  int vertex_step = 3;                   // every n-th fit vertex carries a flow target
+  double max_image_side = 1024;          // images are downsampled to this before the flow
+
+  template <class V>
+  void visit(V& v) {
+    v("enabled", enabled, "Use optical flow between consecutive frames (needs the take's images).");
+    v("term", term, "Weight and noise of the flow targets.");
+    v("max_forward_backward_px", max_forward_backward_px,
+      "Flow whose forward-backward round trip misses by more than this (pixels) is not used.");
+    v("vertex_step", vertex_step, "Every n-th fit vertex carries a flow target in each camera that sees it.");
+    v("max_image_side", max_image_side, "Images are downsampled so that their longer side is at most this for the flow.");
+  }
+};
+
+// 2D landmarks from a user-supplied dlib 68-point shape predictor.
+struct LandmarkOptions {
+  std::string model;  // shape_predictor_68_face_landmarks.dat or one's own; empty = no landmarks
+  ImageTermOptions term{2.0, 0.3, 3.0};
+  int min_views = 2;  // landmarks seen in fewer views are not used for the first pose
+
+  template <class V>
+  void visit(V& v) {
+    v("model", model, "A dlib 68-point shape predictor file (.dat); empty = track without landmarks.");
+    v("term", term, "Weight and noise of the detected landmarks.");
+    v("min_views", min_views, "Views a landmark needs to be triangulated for the first frame's pose.");
+  }
+};
+
+// Priors on the blendshape coefficients and the pose.
+struct CoefficientOptions {
+  double expression_sigma = 1.0;      // prior towards 0 (the neutral face)
+  double expression_temporal_sigma = 0.3;  // frame-to-frame change
+  double identity_sigma = 3.0;        // prior towards 0 (the model's mean), in the model's units
+  double rotation_temporal_sigma_deg = 3.0;
+  double translation_temporal_sigma_m = 0.005;
+  double weight = 0.05;               // share of the energy of these priors
+  int solver_iterations = 15;         // Levenberg-Marquardt iterations per ICP iteration
+
+  template <class V>
+  void visit(V& v) {
+    v("expression_sigma", expression_sigma, "Prior on each expression coefficient towards 0.");
+    v("expression_temporal_sigma", expression_temporal_sigma, "Expected change of a coefficient from one frame to the next.");
+    v("identity_sigma", identity_sigma, "Prior on each identity coefficient towards 0 (the model's mean head).");
+    v("rotation_temporal_sigma_deg", rotation_temporal_sigma_deg, "Expected head rotation between frames, degrees.");
+    v("translation_temporal_sigma_m", translation_temporal_sigma_m, "Expected head translation between frames, metres.");
+    v("weight", weight, "Share of the energy of the priors.");
+    v("solver_iterations", solver_iterations, "Levenberg-Marquardt iterations per ICP iteration.");
+  }
+};
+
+// Per-vertex corrections on top of the blendshapes (identity detail once,
+// then each frame's detail), held smooth by a Laplacian (membrane) term.
+struct CorrectionOptions {
+  bool enabled = true;
+  double smoothness_sigma_m = 0.0002;  // expected difference of neighbouring corrections
+  double magnitude_sigma_m = 0.005;    // corrections are small
+  double temporal_sigma_m = 0.0005;    // a frame's corrections stay near the previous frame's
+  double weight = 1.0;                 // share of the energy of the smoothness term
+  int iterations = 2;                  // correspondence updates
+
+  template <class V>
+  void visit(V& v) {
+    v("enabled", enabled, "Fit per-vertex corrections after the blendshape coefficients.");
+    v("smoothness_sigma_m", smoothness_sigma_m, "Expected difference between neighbouring vertices' corrections, metres.");
+    v("magnitude_sigma_m", magnitude_sigma_m, "Expected size of a correction, metres.");
+    v("temporal_sigma_m", temporal_sigma_m, "Expected change of a frame's corrections from the previous frame's, metres.");
+    v("weight", weight, "Share of the energy of the smoothness term.");
+    v("iterations", iterations, "Correspondence updates while fitting the corrections.");
+  }
+};
+
+struct Options {
+  double model_metres_per_unit = 0.01;
+  std::vector<int> identity_frames = {0};
+  SurfaceTermOptions surface;
+  FlowOptions flow;
+  LandmarkOptions landmarks;
+  CoefficientOptions coefficients;
+  CorrectionOptions corrections;
+  int icp_iterations = 5;
+  double min_inlier_fraction = 0.6;  // a frame whose fit vertices find the mesh less often fails
+  double max_median_distance_m = 0.003;  // ... or whose median distance to it is larger
+  int report_overlays = 3;              // frames of each take drawn over the photos in the report
+  int threads = 0;
+
+  template <class V>
+  void visit(V& v) {
+    v("model_metres_per_unit", model_metres_per_unit, "Units of the model directory's files (ICT-FaceKit: 0.01, cm).");
+    v("identity_frames", identity_frames,
+      "Frames of the first take, with a neutral face, that the subject's identity is fitted to.");
+    v("surface", surface, "The surface (non-rigid ICP) term.");
+    v("flow", flow, "The optical-flow term.");
+    v("landmarks", landmarks, "The 2D landmark term.");
+    v("coefficients", coefficients, "Priors on the coefficients and the pose.");
+    v("corrections", corrections, "Per-vertex corrections.");
+    v("icp_iterations", icp_iterations, "Correspondence updates while fitting pose and coefficients.");
+    v("min_inlier_fraction", min_inlier_fraction,
+      "A frame fails (is recorded, not written) when fewer of its fit vertices than this find the mesh.");
+    v("max_median_distance_m", max_median_distance_m,
+      "... or when their median distance to the mesh is larger than this, metres.");
+    v("report_overlays", report_overlays, "Frames of each take drawn over the photos in the take's report.");
+    v("threads", threads, "Worker threads (0: one per hardware thread).");
+  }
+};
+
+}  // namespace tega::tracking
