@@ -39,25 +39,35 @@ class LandmarkDetector {
   std::unique_ptr<Model> model_;
 };
 
-// One training image: a face, its box and its 68 landmarks (pixels).
+// One training image: a face, its box and its 68 landmarks (pixels). A
+// landmark with a NaN coordinate is unknown (hidden): training skips it. Boxes
+// should be drawn the way detect() will be given them (or, for detect()
+// without a box, the way dlib's frontal face detector draws them).
 struct LandmarkSample {
   Image8 image;
   FaceBox box;
   std::vector<Eigen::Vector2d> landmarks;
 };
 
+// dlib's shape_predictor_trainer settings (Kazemi and Sullivan's ensemble of
+// regression trees), plus mirroring.
 struct LandmarkTrainingOptions {
   int cascade_depth = 10;
   int tree_depth = 4;
   int trees_per_cascade_level = 200;
-  int oversampling = 20;
-  double nu = 0.1;
+  int oversampling = 20;  // random initial shapes per sample
+  double nu = 0.1;        // shrinkage (learning rate) of each tree
+  // Adds every sample mirrored left to right (landmarks renumbered by the
+  // 68-point markup's symmetry): twice the views for the same renders.
+  bool add_mirrored_samples = true;
   int threads = 0;  // 0: one per hardware thread
 };
 
 // Trains a dlib shape predictor (dlib's shape_predictor_trainer) on the
 // samples and writes it to `out` (atomically) in the format
-// LandmarkDetector reads. Throws tega::Error for samples without 68 landmarks.
+// LandmarkDetector reads. Throws tega::Error naming `out` for samples without
+// 68 landmarks or with an empty box or image, a landmark unknown in every
+// sample, or options out of range.
 void train_landmark_predictor(const std::vector<LandmarkSample>& samples, const LandmarkTrainingOptions& options,
                               const std::filesystem::path& out);
 
