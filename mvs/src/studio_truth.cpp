@@ -57,6 +57,12 @@ StudioTruth load_studio_truth(const std::filesystem::path& capture, const std::s
                                                    std::to_string(coarse.num_faces()) + ")");
   for (int f = 0; f < truth.fine.num_faces(); ++f)
     if (region[size_t(f / run)]) truth.face_region.push_back(f);
+  std::vector<char> in_region(size_t(coarse.num_vertices()), 0);
+  for (int f = 0; f < coarse.num_faces(); ++f)
+    if (region[size_t(f)])
+      for (int k = 0; k < 3; ++k) in_region[size_t(coarse.faces(f, k))] = 1;
+  for (int v = 0; v < coarse.num_vertices(); ++v)
+    if (in_region[size_t(v)]) truth.face_vertices.push_back(v);
   return truth;
 }
 

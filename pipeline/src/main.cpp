@@ -33,6 +33,9 @@ int main(int argc, char** argv) {
 #ifdef TEGA_HAVE_MVS
   tega::cli::add_mvs_command(app);
 #endif
+#ifdef TEGA_HAVE_TRACKING
+  tega::cli::add_track_command(app);
+#endif
 #ifdef TEGA_HAVE_TRAINER
   tega::cli::add_train_command(app);
 #endif

@@ -17,11 +17,6 @@ namespace {
 const Eigen::Vector2d kBumpCentres[] = {{0, -0.65}, {0.75, -0.75}, {-0.75, -0.75}, {0, -1.75},
                                         {0, 0.75},  {1.0, -1.45},  {-1.0, -1.45}};
 
-double smoothstep(double edge0, double edge1, double x) {
-  const double t = std::clamp((x - edge0) / (edge1 - edge0), 0.0, 1.0);
-  return t * t * (3 - 2 * t);
-}
-
 }  // namespace
 
 void make_subject(Head& head, const std::vector<double>& identity, double detail_m, uint64_t seed) {
@@ -62,7 +57,7 @@ void make_subject(Head& head, const std::vector<double>& identity, double detail
     if (p.z() < -1.0) continue;  // the back of the head stays as it is
     // The eyelids keep clear of the eyeballs they slide over.
     const double near_eye = std::min((p - eye_left).norm(), (p - eye_right).norm());
-    const double weight = smoothstep(0.3, 0.6, near_eye) * smoothstep(-1.0, -0.4, p.z());
+    const double weight = synth::smoothstep(0.3, 0.6, near_eye) * synth::smoothstep(-1.0, -0.4, p.z());
     for (const Bump& b : bumps)
       offset[v] += weight * b.height * std::exp(-(p.head<2>() - b.centre).squaredNorm() / (2 * b.sigma * b.sigma));
   }

@@ -141,11 +141,12 @@ TEST(StageGraph, RejectsUnknownKindsCyclesAndMissingArtifacts) {
 
 TEST(StageGraph, StagesWithoutACommandAreUnavailableWithTheReason) {
   const StageGraph g(parse("workspace: ws\nstages:\n  capture:\n  calibrate: {after: capture}\n"
-                           "  mvs: {after: calibrate}\n  tracking: {after: mvs}\n  synth:\n  train: {after: synth}\n"
+                           "  mvs: {after: calibrate}\n  track: {after: mvs}\n  matting: {after: track}\n  synth:\n"
+                           "  train: {after: synth}\n"
                            "  eval: {after: [train]}\n"),
                      [](const std::vector<std::string>& command) { return command[0] != "eval"; });
   for (const auto& stage : g.stages()) {
-    if (stage.name() == "tracking") {
+    if (stage.name() == "matting") {
       EXPECT_FALSE(stage.available);
       EXPECT_NE(stage.unavailable_reason.find("not implemented in tega yet"), std::string::npos);
     } else if (stage.name() == "eval") {

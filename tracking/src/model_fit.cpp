@@ -82,7 +82,7 @@ class ModelPointCost final : public ceres::CostFunction {
   }
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    const Eigen::Quaterniond q(Eigen::Map<const Eigen::Vector4d>(parameters[0]));
+    const Eigen::Map<const Eigen::Quaterniond> q(parameters[0]);
     const Eigen::Quaterniond unit = q.normalized();
     const Eigen::Matrix3d R = unit.toRotationMatrix();
     const Eigen::Vector3d t(parameters[1]);

@@ -165,8 +165,22 @@ std::vector<StageKind> make_stage_kinds() {
                        p);
   };
   kinds.push_back(mvs);
-  kinds.push_back(not_implemented("tracking", "fits the blendshape template to the per-frame meshes",
-                                  {"meshes", "rig"}, {{"tracked", "tracked"}}));
+  // Every performance take, its frames in order; the model is an option (a path).
+  StageKind track;
+  track.name = "track";
+  track.summary = "fits the blendshape head model to every frame's mesh (tega track)";
+  track.subcommand = {"track"};
+  track.needs = {"capture", "rig", "meshes"};
+  track.provides = {{"tracked", "tracked"}};
+  track.options_section = "track";
+  track.path_options = {"model", "identity", "landmarks.model"};
+  track.resumes_in_staging = true;
+  track.arguments = [](const ShardPaths& p) {
+    return with_config({"--capture", p.artifacts.at("capture").string(), "--rig", p.artifacts.at("rig").string(),
+                        "--meshes", p.artifacts.at("meshes").string(), "--out", (p.output / "tracked").string()},
+                       p);
+  };
+  kinds.push_back(track);
   kinds.push_back(not_implemented("matting", "mattes and downsamples the images into a dataset",
                                   {"capture", "rig", "tracked"}, {{"dataset", "dataset"}}));
   return kinds;

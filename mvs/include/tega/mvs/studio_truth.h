@@ -22,6 +22,7 @@ namespace tega::mvs {
 struct StudioTruth {
   Mesh fine;                     // world space
   std::vector<int> face_region;  // faces of `fine`
+  std::vector<int> face_vertices;  // the same region's vertices of the coarse template (tracked meshes)
 };
 
 // Throws tega::Error naming the file when the capture lacks ground truth.

@@ -124,6 +124,8 @@ struct CorrectionOptions {
 };
 
 struct Options {
+  std::string model;     // the head model directory
+  std::string identity;  // an identity.json to reuse; empty: fit one
   double model_metres_per_unit = 0.01;
   std::vector<int> identity_frames = {0};
   SurfaceTermOptions surface;
@@ -139,6 +141,10 @@ struct Options {
 
   template <class V>
   void visit(V& v) {
+    v("model", model,
+      "The head model directory: ICT-FaceKit's layout (generic_neutral_mesh.obj, identityNNN.obj, expression "
+      "shapes) with vertex_indices.json.");
+    v("identity", identity, "An identity.json from an earlier run of this subject to reuse; empty = fit the identity.");
     v("model_metres_per_unit", model_metres_per_unit, "Units of the model directory's files (ICT-FaceKit: 0.01, cm).");
     v("identity_frames", identity_frames,
       "Frames of the first take, with a neutral face, that the subject's identity is fitted to.");

@@ -51,10 +51,18 @@ struct FrameObservation {
   std::vector<Image8> images;
 };
 
+// Where a frame's time went, seconds.
+struct FrameTimings {
+  double image_terms_s = 0;   // optical flow and landmarks
+  double coefficients_s = 0;  // pose and expression (correspondences included)
+  double corrections_s = 0;   // per-vertex corrections (correspondences included)
+};
+
 struct FrameFit {
   HeadState state;
   Vertices vertices;  // world space, the model's topology
   FrameResiduals residuals;
+  FrameTimings timings;
 };
 
 // World-space vertices of the model in `state`.

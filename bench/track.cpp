@@ -1,0 +1,112 @@
+// bench/track: time per frame of template tracking for ICT-FaceKit's topology
+// (26,719 vertices) on a virtual-studio capture it renders (13 cameras) or
+// one given: the identity fit once, then per frame the image terms (optical
+// flow, landmarks), pose and expression, and per-vertex corrections. Scans
+// are the capture's MVS meshes (--meshes) or, by default, its true meshes.
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+
+#include "tega/core/mesh.h"
+#include "tega/core/rig.h"
+#include "tega/core/take.h"
+#include "tega/core/thread_pool.h"
+#include "tega/synth/virtual_studio.h"
+#include "tega/tracking/head_model.h"
+#include "tega/tracking/landmarks.h"
+#include "tega/tracking/tracker.h"
+
+namespace fs = std::filesystem;
+using namespace tega;
+
+namespace {
+
+Mesh scan_of(const fs::path& capture, const fs::path& meshes, const Mesh& fine_topology, int frame) {
+  char name[32];
+  std::snprintf(name, sizeof name, "%06d", frame);
+  if (!meshes.empty()) return read_mesh(meshes / "expressions" / (std::string(name) + ".ply"));
+  Mesh scan = fine_topology;
+  scan.positions = read_vertices_bin(capture / "ground_truth" / "expressions" / "fine" / (std::string(name) + ".bin"),
+                                     fine_topology.num_vertices());
+  return scan;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Time per frame of tega's template tracking (ICT-FaceKit topology)."};
+  std::string model_dir = "../shared/data/ict-facekit", capture_dir, meshes_dir, landmarks;
+  int frames = 8, width = 512, height = 384, threads = 2;
+  app.add_option("--model", model_dir, "The ICT-FaceKit directory.");
+  app.add_option("--capture", capture_dir, "A virtual-studio capture to track (default: render one).");
+  app.add_option("--meshes", meshes_dir, "Its MVS meshes (MESHES/expressions/<frame>.ply; default: the true meshes).");
+  app.add_option("--frames", frames, "Frames of the take to render and track.");
+  app.add_option("--width", width, "Image width of the rendered capture.");
+  app.add_option("--height", height, "Image height of the rendered capture.");
+  app.add_option("--threads", threads, "Worker threads (the target machine has 2 cores).");
+  app.add_option("--landmarks", landmarks, "A dlib 68-point shape predictor for the landmark term.");
+  CLI11_PARSE(app, argc, argv);
+
+  fs::path capture = capture_dir;
+  if (capture.empty()) {
+    capture = fs::temp_directory_path() / "tega-track-bench";
+    synth::Options studio;
+    studio.studio.width = width;
+    studio.studio.height = height;
+    studio.frames = frames;
+    studio.calibration_frames = 0;
+    studio.takes = {"expressions"};
+    studio.test_takes = {};
+    studio.head = model_dir;
+    studio.head_identity = {0.9, -0.6, 0.5, 0.3, -0.4};
+    studio.head_shape_detail_m = 0.002;
+    studio.threads = threads;
+    std::printf("rendering %s (%d frames, 13 cameras, %dx%d)\n", capture.c_str(), frames, width, height);
+    synth::render_virtual_studio(studio, capture, true);
+  }
+
+  tracking::Options options;
+  options.threads = threads;
+  options.landmarks.model = landmarks;
+  const tracking::HeadModel model = tracking::load_head_model(model_dir, options.model_metres_per_unit);
+  const std::unique_ptr<tracking::LandmarkDetector> detector =
+      landmarks.empty() ? nullptr : std::make_unique<tracking::LandmarkDetector>(landmarks);
+  const Rig rig = read_rig_json(capture / "rig.json");
+  const TakeInfo take = read_take(capture / "takes" / "expressions");
+  const Mesh fine_topology = meshes_dir.empty() ? read_obj(capture / "ground_truth" / "head" / "fine_topology.obj") : Mesh{};
+  const auto photos = [&](int frame) {
+    std::vector<Image8> images;
+    for (const auto& camera : take.cameras) images.push_back(read_image_u8(take.image_path(camera, frame)));
+    return images;
+  };
+
+  const Mesh first = scan_of(capture, meshes_dir, fine_topology, 0);
+  auto start = std::chrono::steady_clock::now();
+  const tracking::SubjectIdentity subject =
+      tracking::fit_identity(model, {{&first, photos(0)}}, rig.cameras, options, detector.get());
+  std::printf("identity fit: %.2f s (once per subject)\n", seconds_since(start));
+
+  tracking::TakeTracker tracker(model, subject, rig.cameras, options, detector.get());
+  std::printf("%-6s %10s %14s %14s %14s %10s\n", "frame", "scan (s)", "image terms", "pose+expr", "corrections",
+              "total (s)");
+  double total = 0;
+  int counted = 0;
+  for (int frame = 0; frame < take.frames; ++frame) {
+    const Mesh scan = scan_of(capture, meshes_dir, fine_topology, frame);
+    const tracking::FrameObservation observation{&scan, photos(frame)};
+    start = std::chrono::steady_clock::now();
+    const tracking::FrameFit fit = tracker.track(observation);
+    const double seconds = seconds_since(start);
+    tracker.accept(fit, observation);
+    std::printf("%-6d %10d %14.2f %14.2f %14.2f %10.2f\n", frame, scan.num_faces(), fit.timings.image_terms_s,
+                fit.timings.coefficients_s, fit.timings.corrections_s, seconds);
+    if (frame > 0) total += seconds, ++counted;  // frame 0 also finds the first pose
+  }
+  if (counted) std::printf("mean over frames 1..%d: %.2f s per frame (%d threads)\n", take.frames - 1, total / counted, threads);
+  return 0;
+}

@@ -1,0 +1,135 @@
+// tega track on a 13-camera virtual-studio capture of an ICT-FaceKit subject
+// the model can only approximate (identity shapes plus off-model detail),
+// driven by tega's own MVS meshes, scored against the studio's ground truth
+// (the targets); then with the true meshes as scans (the upper
+// bound), a frame without a scan, and resuming. One test: the capture and
+// its meshes take minutes to make on two cores.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "small_studio.h"
+#include "tega/core/files.h"
+#include "tega/core/mesh.h"
+#include "tega/mvs/reconstruction.h"
+#include "tega/synth/virtual_studio.h"
+#include "tega/tracking/evaluation.h"
+#include "tega/tracking/tracking.h"
+#include "test_support.h"
+
+namespace fs = std::filesystem;
+
+namespace tega::tracking {
+namespace {
+
+constexpr int kFrames = 10;
+
+void print_scores(const char* label, const TrackScores& s) {
+  std::printf("%s: %d frames, vertex error median %.3f mm, p95 %.3f mm, rotation median %.3f deg, max %.3f deg\n",
+              label, s.frames, 1000 * s.vertex_median_m, 1000 * s.vertex_p95_m, s.rotation_median_deg,
+              s.rotation_max_deg);
+  for (const auto& [name, r] : s.correlation) std::printf("  %s: r = %.3f\n", name.c_str(), r);
+}
+
+void expect_targets(const TrackScores& s) {
+  EXPECT_EQ(s.frames, kFrames);
+  EXPECT_LE(s.vertex_median_m, 0.001);
+  EXPECT_LE(s.vertex_p95_m, 0.003);
+  EXPECT_LE(s.rotation_max_deg, 0.5);
+  for (const char* name : {"eyeBlink_L", "eyeBlink_R", "jawOpen"}) {
+    ASSERT_TRUE(s.correlation.count(name)) << name << " does not vary in the take";
+    EXPECT_GE(s.correlation.at(name), 0.9) << name;
+  }
+}
+
+// The true fine meshes as the scans (what a perfect MVS would give).
+void write_true_scans(const fs::path& capture, const fs::path& meshes) {
+  Mesh fine = read_obj(capture / "ground_truth" / "head" / "fine_topology.obj");
+  fine.uvs.resize(0, 2);
+  fine.uv_faces.resize(0, 3);
+  fs::create_directories(meshes / "expressions");
+  for (int frame = 0; frame < kFrames; ++frame) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%06d", frame);
+    fine.positions = read_vertices_bin(capture / "ground_truth" / "expressions" / "fine" / (std::string(name) + ".bin"),
+                                       fine.num_vertices());
+    write_ply(fine, meshes / "expressions" / (std::string(name) + ".ply"));
+  }
+}
+
+TEST(StudioTracking, TracksTegasOwnMeshesWithinTheTargets) {
+  const auto shared = test::shared_data_dir();
+  if (!shared || !fs::exists(*shared / "ict-facekit" / "vertex_indices.json"))
+    GTEST_SKIP() << "ICT-FaceKit is not in ../shared/data";
+  const test::TempDir dir;
+  synth::Options studio = test::small_studio(13, 512, 384, kFrames);
+  studio.head = (*shared / "ict-facekit").string();
+  studio.head_identity = {0.9, -0.6, 0.5, 0.3, -0.4};
+  studio.head_shape_detail_m = 0.002;
+  studio.write_fine_meshes = true;
+  const fs::path capture = dir / "capture";
+  synth::render_virtual_studio(studio, capture);
+
+  // Lighter MVS than the default: the tracker, not the meshes, is under test here.
+  mvs::Options mvs_options;
+  mvs_options.device = "cpu";
+  mvs_options.surface.threads = 1;
+  mvs_options.patch_match.iterations = 3;
+  mvs_options.patch_match.geometric_iterations = 1;
+  mvs::MvsRequest mvs_request;
+  mvs_request.capture = capture;
+  mvs_request.out = dir / "meshes";
+  mvs::reconstruct_capture(mvs_request, mvs_options);
+
+  Options options;
+  options.model = (*shared / "ict-facekit").string();
+  options.threads = 2;
+  const TrackSummary summary = track_capture({capture, {}, dir / "meshes", dir / "tracked", {}}, options);
+  EXPECT_EQ(summary.frames_tracked, kFrames);
+  const TrackScores scores = score_against_studio(dir / "tracked" / "expressions", capture, "expressions");
+  print_scores("tega's MVS meshes", scores);
+  expect_targets(scores);
+
+  // What the take's folder holds.
+  const fs::path take = dir / "tracked" / "expressions";
+  EXPECT_TRUE(fs::exists(dir / "tracked" / "identity.json"));
+  EXPECT_TRUE(fs::exists(dir / "tracked" / "identity_neutral.obj"));
+  EXPECT_TRUE(fs::exists(take / "report" / "residuals.png"));
+  int overlays = 0;
+  for (const auto& entry : fs::directory_iterator(take / "report"))
+    overlays += entry.path().filename().string().rfind("overlay_", 0) == 0;
+  EXPECT_EQ(overlays, options.report_overlays);
+  const auto record = nlohmann::json::parse(read_text_file(take / "000004.json"));
+  EXPECT_EQ(record["status"], "tracked");
+  EXPECT_GT(record["residuals"]["flow_points"].get<int>(), 1000);
+
+  // Run again: every frame is kept.
+  const TrackSummary again = track_capture({capture, {}, dir / "meshes", dir / "tracked", {}}, options);
+  EXPECT_EQ(again.frames_tracked, 0);
+  EXPECT_EQ(again.frames_kept, kFrames);
+
+  // The upper bound: the true meshes as scans, and the identity reused.
+  write_true_scans(capture, dir / "true_meshes");
+  Options reuse = options;
+  reuse.identity = (dir / "tracked" / "identity.json").string();
+  track_capture({capture, {}, dir / "true_meshes", dir / "tracked_on_truth", {}}, reuse);
+  const TrackScores bound = score_against_studio(dir / "tracked_on_truth" / "expressions", capture, "expressions");
+  print_scores("true meshes", bound);
+  expect_targets(bound);
+
+  // A frame without a scan is recorded and skipped; its neighbours are tracked.
+  fs::remove(dir / "true_meshes" / "expressions" / "000005.ply");
+  const TrackSummary gap = track_capture({capture, {}, dir / "true_meshes", dir / "tracked_with_gap", {}}, reuse);
+  EXPECT_EQ(gap.frames_skipped, 1);
+  EXPECT_EQ(gap.frames_tracked, kFrames - 1);
+  const auto skipped = nlohmann::json::parse(read_text_file(dir / "tracked_with_gap" / "expressions" / "000005.json"));
+  EXPECT_EQ(skipped["status"], "skipped");
+  EXPECT_NE(skipped["reason"].get<std::string>().find("000005.ply"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir / "tracked_with_gap" / "expressions" / "000005.bin"));
+  const auto summary_json = nlohmann::json::parse(read_text_file(dir / "tracked_with_gap" / "expressions" / "track.json"));
+  EXPECT_EQ(summary_json["frames_not_tracked"].size(), 1u);
+}
+
+}  // namespace
+}  // namespace tega::tracking

@@ -1,0 +1,191 @@
+// The fits on scans made from the model itself: a subject the model only
+// approximates (identity shapes plus off-model detail, by the virtual
+// studio's make_subject), posed with known expressions and head motion. No
+// photos: the surface term alone must recover identity, pose and the
+// expressions that change the surface's shape (a blink slides the eyelid
+// over the eyeball, along the surface: the image terms catch it, see
+// studio_tracking_test.cpp).
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <fstream>
+
+#include "tega/core/error.h"
+#include "tega/synth/head.h"
+#include "tega/synth/studio_rig.h"
+#include "tega/tracking/head_model.h"
+#include "tega/tracking/tracker.h"
+#include "test_support.h"
+
+namespace fs = std::filesystem;
+
+namespace tega::tracking {
+namespace {
+
+std::optional<fs::path> ict_model() {
+  const auto shared = test::shared_data_dir();
+  if (!shared || !fs::exists(*shared / "ict-facekit" / "vertex_indices.json")) return std::nullopt;
+  return *shared / "ict-facekit";
+}
+
+// The subject the scans show, in the model's full topology.
+Vertices subject_neutral(const HeadModel& model) {
+  synth::Head head;
+  head.source = "test subject";
+  head.model = model.shapes;
+  std::vector<char> eyeball(size_t(model.num_vertices()), 0);
+  for (int v : model.eyeball_vertices) eyeball[size_t(v)] = 1;
+  const Triangles& faces = model.shapes.neutral.faces;
+  for (int f = 0; f < faces.rows(); ++f)
+    if (eyeball[size_t(faces(f, 0))]) head.eyeball_faces.push_back(f);
+  synth::finish_head(head);
+  synth::make_subject(head, {0.9, -0.6, 0.5, 0.3, -0.4}, 0.002, 7);
+  return head.model.neutral.positions;
+}
+
+// What a scanner sees of the posed subject: the skin and the eyeballs.
+Mesh scan_of(const HeadModel& model, const Vertices& world) {
+  std::vector<char> seen(size_t(model.num_vertices()), 0);
+  for (int v : model.skin_vertices) seen[size_t(v)] = 1;
+  for (int v : model.eyeball_vertices) seen[size_t(v)] = 1;
+  Mesh scan;
+  scan.positions = world;
+  const Triangles& faces = model.shapes.neutral.faces;
+  std::vector<int> kept;
+  for (int f = 0; f < faces.rows(); ++f)
+    if (seen[size_t(faces(f, 0))] && seen[size_t(faces(f, 1))] && seen[size_t(faces(f, 2))]) kept.push_back(f);
+  scan.faces.resize(Eigen::Index(kept.size()), 3);
+  for (size_t i = 0; i < kept.size(); ++i) scan.faces.row(Eigen::Index(i)) = faces.row(kept[i]);
+  return scan;
+}
+
+struct TruthFrame {
+  HeadState state;
+  Vertices world;
+};
+
+TruthFrame truth_frame(const HeadModel& model, const Vertices& neutral, double turn_deg,
+                       const std::vector<std::pair<std::string, double>>& expression) {
+  TruthFrame t;
+  t.state.expression.assign(model.shapes.expression_deltas.size(), 0.0);
+  for (const auto& [name, value] : expression) t.state.expression[size_t(model.shapes.expression_index(name))] = value;
+  const Eigen::Vector3d pivot(0, 0.02, 0);
+  t.state.head_to_world.R = Eigen::AngleAxisd(turn_deg * M_PI / 180, Eigen::Vector3d(0.2, 1, 0.1).normalized()).toRotationMatrix();
+  t.state.head_to_world.t = -t.state.head_to_world.R * pivot + Eigen::Vector3d(0.003, -0.002, 0.004);
+  t.world = pose_vertices(model, {{}, neutral}, t.state);
+  return t;
+}
+
+double rotation_error_deg(const RigidTransform& a, const RigidTransform& b) {
+  return Eigen::AngleAxisd(a.R.transpose() * b.R).angle() * 180 / M_PI;
+}
+
+Options scan_only_options() {
+  Options o;
+  o.flow.enabled = false;
+  o.threads = 2;
+  return o;
+}
+
+TEST(Tracker, FitsIdentityPoseAndExpressionToScansOfTheModel) {
+  const auto dir = ict_model();
+  if (!dir) GTEST_SKIP() << "ICT-FaceKit is not in ../shared/data";
+  const HeadModel model = load_head_model(*dir, 0.01);
+  const Vertices neutral = subject_neutral(model);
+  const std::vector<Camera> cameras = synth::make_studio_rig({}).cameras;
+  const Options options = scan_only_options();
+
+  const TruthFrame rest = truth_frame(model, neutral, 0, {});
+  const Mesh rest_scan = scan_of(model, rest.world);
+  const SubjectIdentity subject = fit_identity(model, {{&rest_scan, {}}}, cameras, options, nullptr);
+  std::vector<double> identity_errors;
+  for (int v : model.fit_vertices) identity_errors.push_back((subject.neutral.row(v) - neutral.row(v)).norm());
+  std::sort(identity_errors.begin(), identity_errors.end());
+  const double identity_median = identity_errors[identity_errors.size() / 2];
+  std::printf("identity: median vertex error %.3f mm (head space)\n", 1000 * identity_median);
+
+  TakeTracker tracker(model, subject, cameras, options, nullptr);
+  const std::vector<TruthFrame> frames = {
+      rest, truth_frame(model, neutral, 2, {{"jawOpen", 0.3}}),
+      truth_frame(model, neutral, 4, {{"jawOpen", 0.6}, {"eyeBlink_L", 0.8}, {"eyeBlink_R", 0.8}}),
+      truth_frame(model, neutral, 5, {{"mouthSmile_L", 0.7}, {"mouthSmile_R", 0.7}, {"browInnerUp_L", 0.5}})};
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const Mesh scan = scan_of(model, frames[i].world);
+    const FrameFit fit = tracker.track({&scan, {}});
+    EXPECT_FALSE(tracker.rejection(fit).has_value()) << *tracker.rejection(fit);
+    tracker.accept(fit, {&scan, {}});
+    std::vector<double> errors;
+    for (int v : model.fit_vertices) errors.push_back((fit.vertices.row(v) - frames[i].world.row(v)).norm());
+    std::sort(errors.begin(), errors.end());
+    const double median = errors[errors.size() / 2], p95 = errors[errors.size() * 95 / 100];
+    const double rotation = rotation_error_deg(fit.state.head_to_world, frames[i].state.head_to_world);
+    const int jaw = model.shapes.expression_index("jawOpen"), blink = model.shapes.expression_index("eyeBlink_L");
+    std::printf("frame %zu: vertex error median %.3f mm, p95 %.3f mm, rotation %.3f deg, jawOpen %.2f (true %.2f), "
+                "eyeBlink_L %.2f (true %.2f), scan distance median %.3f mm, %.2f s\n",
+                i, 1000 * median, 1000 * p95, rotation, fit.state.expression[jaw], frames[i].state.expression[jaw],
+                fit.state.expression[blink], frames[i].state.expression[blink], 1000 * fit.residuals.surface_median_m,
+                fit.timings.image_terms_s + fit.timings.coefficients_s + fit.timings.corrections_s);
+    EXPECT_LT(median, 0.0005);
+    EXPECT_LT(p95, 0.002);
+    EXPECT_LT(rotation, 0.3);
+    EXPECT_NEAR(fit.state.expression[jaw], frames[i].state.expression[jaw], 0.1);
+  }
+}
+
+TEST(Tracker, AScanFarFromTheHeadIsRejectedNotTracked) {
+  const auto dir = ict_model();
+  if (!dir) GTEST_SKIP() << "ICT-FaceKit is not in ../shared/data";
+  const HeadModel model = load_head_model(*dir, 0.01);
+  const Vertices neutral = subject_neutral(model);
+  const std::vector<Camera> cameras = synth::make_studio_rig({}).cameras;
+  const Options options = scan_only_options();
+  const TruthFrame rest = truth_frame(model, neutral, 0, {});
+  const Mesh rest_scan = scan_of(model, rest.world);
+  const SubjectIdentity subject = fit_identity(model, {{&rest_scan, {}}}, cameras, options, nullptr);
+  TakeTracker tracker(model, subject, cameras, options, nullptr);
+  const FrameFit first = tracker.track({&rest_scan, {}});
+  ASSERT_FALSE(tracker.rejection(first).has_value());
+  tracker.accept(first, {&rest_scan, {}});
+
+  // The next scan is of something else, 15 cm away.
+  Mesh elsewhere = rest_scan;
+  elsewhere.positions.col(0).array() += 0.15f;
+  const FrameFit fit = tracker.track({&elsewhere, {}});
+  const auto reason = tracker.rejection(fit);
+  ASSERT_TRUE(reason.has_value());
+  EXPECT_NE(reason->find("of the face lies within"), std::string::npos) << *reason;
+}
+
+TEST(HeadModel, MismatchedShapesAndIndexSetsAreNamed) {
+  const auto dir = ict_model();
+  if (!dir) GTEST_SKIP() << "ICT-FaceKit is not in ../shared/data";
+  const test::TempDir tmp;
+  const fs::path model = tmp / "model";
+  fs::create_directories(model);
+  for (const char* file : {"generic_neutral_mesh.obj", "jawOpen.obj", "vertex_indices.json"})
+    fs::copy_file(*dir / file, model / file);
+  // A shape of another topology: the template's first lines only.
+  {
+    std::ifstream in(*dir / "eyeBlink_L.obj");
+    std::ofstream out(model / "eyeBlink_L.obj");
+    std::string line;
+    for (int i = 0; i < 200 && std::getline(in, line); ++i) out << line << "\n";
+  }
+  try {
+    load_head_model(model, 0.01);
+    FAIL() << "a shape with other vertices was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("eyeBlink_L.obj"), std::string::npos) << e.what();
+  }
+  fs::remove(model / "eyeBlink_L.obj");
+  fs::remove(model / "vertex_indices.json");
+  try {
+    load_head_model(model, 0.01);
+    FAIL() << "a model without its index sets was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("vertex_indices.json"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace tega::tracking

@@ -1,0 +1,101 @@
+#include "tega/tracking/evaluation.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "tega/core/error.h"
+#include "tega/core/files.h"
+#include "tega/core/mesh.h"
+#include "tega/mvs/studio_truth.h"
+
+namespace tega::tracking {
+namespace fs = std::filesystem;
+
+namespace {
+
+nlohmann::json read_json(const fs::path& file) {
+  try {
+    return nlohmann::json::parse(read_text_file(file));
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(file, std::string("is not valid JSON: ") + e.what());
+  }
+}
+
+Eigen::Matrix3d rotation_of(const nlohmann::json& rows) {
+  Eigen::Matrix3d R;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) R(r, c) = rows.at(r).at(c);
+  return R;
+}
+
+double percentile(std::vector<double> values, double q) {
+  if (values.empty()) return 0;
+  const size_t k = std::min(values.size() - 1, size_t(q * double(values.size())));
+  std::nth_element(values.begin(), values.begin() + long(k), values.end());
+  return values[k];
+}
+
+double pearson(const std::vector<double>& a, const std::vector<double>& b) {
+  const double n = double(a.size());
+  double ma = 0, mb = 0;
+  for (size_t i = 0; i < a.size(); ++i) ma += a[i] / n, mb += b[i] / n;
+  double sab = 0, saa = 0, sbb = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    sab += (a[i] - ma) * (b[i] - mb);
+    saa += (a[i] - ma) * (a[i] - ma);
+    sbb += (b[i] - mb) * (b[i] - mb);
+  }
+  return saa > 0 && sbb > 0 ? sab / std::sqrt(saa * sbb) : 0;
+}
+
+}  // namespace
+
+TrackScores score_against_studio(const fs::path& tracked_take, const fs::path& capture, const std::string& take) {
+  const mvs::StudioTruth truth = mvs::load_studio_truth(capture, take, 0);
+  const auto frames = read_json(capture / "ground_truth" / take / "frames.json");
+  const Mesh coarse = read_obj(capture / "ground_truth" / "head" / "template.obj");
+  TrackScores scores;
+  std::vector<double> errors, rotations;
+  std::map<std::string, std::pair<std::vector<double>, std::vector<double>>> series;  // truth, tracked
+  for (const auto& truth_frame : frames.at("frames")) {
+    const int frame = truth_frame.at("index");
+    char name[32];
+    std::snprintf(name, sizeof name, "%06d", frame);
+    const fs::path record_file = tracked_take / (std::string(name) + ".json");
+    if (!fs::exists(record_file)) continue;
+    const auto record = read_json(record_file);
+    if (record.at("status") != "tracked") continue;
+    ++scores.frames;
+    const Vertices tracked = read_vertices_bin(tracked_take / (std::string(name) + ".bin"));
+    const Vertices true_mesh =
+        read_vertices_bin(capture / "ground_truth" / take / "coarse" / (std::string(name) + ".bin"), coarse.num_vertices());
+    for (int v : truth.face_vertices) {
+      if (v >= tracked.rows()) throw Error(tracked_take, "has fewer vertices than the studio's face region needs");
+      errors.push_back((tracked.row(v) - true_mesh.row(v)).cast<double>().norm());
+    }
+    const Eigen::Matrix3d R = rotation_of(record.at("head_to_world"));
+    const Eigen::Matrix3d R_true = rotation_of(truth_frame.at("head_to_world"));
+    rotations.push_back(Eigen::AngleAxisd(R.transpose() * R_true).angle() * 180 / M_PI);
+    for (const auto& [expression, value] : truth_frame.at("expression").items()) {
+      auto& [truth_values, tracked_values] = series[expression];
+      truth_values.push_back(value.get<double>());
+      tracked_values.push_back(record.at("expression").value(expression, 0.0));
+    }
+  }
+  if (scores.frames == 0) throw Error(tracked_take, "has no tracked frame to score");
+  scores.vertex_median_m = percentile(errors, 0.5);
+  scores.vertex_p95_m = percentile(errors, 0.95);
+  scores.rotation_median_deg = percentile(rotations, 0.5);
+  scores.rotation_max_deg = *std::max_element(rotations.begin(), rotations.end());
+  for (const auto& [expression, values] : series) {
+    const auto& truth_values = values.first;
+    if (*std::max_element(truth_values.begin(), truth_values.end()) - *std::min_element(truth_values.begin(), truth_values.end()) > 0.1)
+      scores.correlation[expression] = pearson(truth_values, values.second);
+  }
+  return scores;
+}
+
+}  // namespace tega::tracking

@@ -1,0 +1,106 @@
+#include "frame_record.h"
+
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "tega/core/error.h"
+#include "tega/core/files.h"
+#include "tega/core/mesh.h"
+
+namespace tega::tracking {
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path frame_file(const fs::path& dir, int frame, const char* extension) {
+  char name[32];
+  std::snprintf(name, sizeof name, "%06d%s", frame, extension);
+  return dir / name;
+}
+
+nlohmann::json residuals_json(const FrameResiduals& r) {
+  nlohmann::json j = {{"surface_median_mm", 1000 * r.surface_median_m},
+                      {"surface_p90_mm", 1000 * r.surface_p90_m},
+                      {"inlier_fraction", r.inlier_fraction}};
+  if (r.landmark_count > 0) j["landmark_rms_px"] = r.landmark_rms_px, j["landmarks"] = r.landmark_count;
+  if (r.flow_count > 0) j["flow_rms_px"] = r.flow_rms_px, j["flow_points"] = r.flow_count;
+  return j;
+}
+
+FrameResiduals residuals_of(const nlohmann::json& j) {
+  FrameResiduals r;
+  r.surface_median_m = j.at("surface_median_mm").get<double>() / 1000;
+  r.surface_p90_m = j.at("surface_p90_mm").get<double>() / 1000;
+  r.inlier_fraction = j.at("inlier_fraction");
+  r.landmark_rms_px = j.value("landmark_rms_px", -1.0);
+  r.landmark_count = j.value("landmarks", 0);
+  r.flow_rms_px = j.value("flow_rms_px", -1.0);
+  r.flow_count = j.value("flow_points", 0);
+  return r;
+}
+
+}  // namespace
+
+void write_frame_record(const fs::path& take_dir, const FrameRecord& record, const Vertices* vertices,
+                        const HeadModel& model) {
+  nlohmann::json j;
+  j["frame"] = record.frame;
+  j["status"] = record.status;
+  if (!record.reason.empty()) j["reason"] = record.reason;
+  if (record.status != "skipped") {
+    const auto m = record.state.head_to_world.matrix();
+    j["head_to_world"] = nlohmann::json::array();
+    for (int r = 0; r < 3; ++r) j["head_to_world"].push_back({m(r, 0), m(r, 1), m(r, 2), m(r, 3)});
+    nlohmann::json expression = nlohmann::json::object();
+    for (size_t k = 0; k < record.state.expression.size(); ++k)
+      expression[model.shapes.expression_names[k]] = record.state.expression[k];
+    j["expression"] = expression;
+    j["residuals"] = residuals_json(record.residuals);
+  }
+  if (vertices) {
+    write_vertices_bin(*vertices, frame_file(take_dir, record.frame, ".bin"));
+    j["mesh"] = frame_file(take_dir, record.frame, ".bin").filename().string();
+  }
+  write_text_atomic(frame_file(take_dir, record.frame, ".json"), j.dump(2) + "\n");
+}
+
+std::optional<StoredFrame> read_frame_record(const fs::path& take_dir, int frame, const HeadModel& model,
+                                             const SubjectIdentity* subject) {
+  const fs::path file = frame_file(take_dir, frame, ".json");
+  if (!fs::exists(file)) return std::nullopt;
+  StoredFrame stored;
+  FrameRecord& record = stored.record;
+  try {
+    const auto j = nlohmann::json::parse(read_text_file(file));
+    record.frame = j.at("frame");
+    record.status = j.at("status");
+    record.reason = j.value("reason", "");
+    if (record.status != "skipped") {
+      Eigen::Matrix<double, 3, 4> m;
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c) m(r, c) = j.at("head_to_world").at(r).at(c);
+      record.state.head_to_world = RigidTransform::from_matrix(m);
+      const auto& expression = j.at("expression");
+      for (const auto& name : model.shapes.expression_names) {
+        if (!expression.contains(name))
+          throw Error(file, "has no coefficient for expression " + name + " of the model " + model.directory.string());
+        record.state.expression.push_back(expression.at(name));
+      }
+      record.residuals = residuals_of(j.at("residuals"));
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(file, std::string("is not a valid frame record: ") + e.what());
+  }
+  stored.state = record.state;
+  if (record.status == "tracked" && subject) {
+    const Vertices world = read_vertices_bin(frame_file(take_dir, frame, ".bin"), model.num_vertices());
+    HeadState shaped = record.state;
+    shaped.corrections.resize(0, 3);
+    const Vertices without = pose_vertices(model, *subject, shaped);
+    const Eigen::Matrix3f Rt = record.state.head_to_world.R.transpose().cast<float>();
+    stored.state.corrections = (world - without) * Rt.transpose();
+  }
+  return stored;
+}
+
+}  // namespace tega::tracking

@@ -1,0 +1,121 @@
+// Where the head is before any frame says so: landmarks triangulated across
+// views where a detector finds the face, else the scan's front and the rig's
+// orientation; then rigid ICP on the parts of the face no expression moves.
+#include <algorithm>
+
+#include "frame_targets.h"
+#include "rigid_alignment.h"
+#include "tega/core/error.h"
+#include "tega/core/log.h"
+
+namespace tega::tracking {
+namespace {
+
+constexpr int kRigidIcpIterations = 8;
+constexpr double kRigidIcpStartDistanceM = 0.04;
+constexpr double kFrontFacingCosine = 0.3;
+
+// The point closest to all rays (camera centre, unit direction) in the least-squares sense.
+Eigen::Vector3d closest_to_rays(const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>& rays) {
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  for (const auto& [origin, direction] : rays) {
+    const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - direction * direction.transpose();
+    A += P;
+    b += P * origin;
+  }
+  return A.ldlt().solve(b);
+}
+
+std::optional<RigidTransform> pose_from_landmarks(const HeadModel& model, const Vertices& neutral,
+                                                  const FrameObservation& frame, const std::vector<Camera>& cameras,
+                                                  const LandmarkDetector& detector, int min_views) {
+  if (model.landmark_vertices.empty()) return std::nullopt;
+  std::vector<std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>> rays(kLandmarkCount);
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    if (c >= frame.images.size() || frame.images[c].pixels.empty()) continue;
+    const auto found = detector.detect(frame.images[c], std::nullopt);
+    if (!found) continue;
+    for (int l = 0; l < kLandmarkCount; ++l)
+      rays[size_t(l)].emplace_back(cameras[c].center(), cameras[c].ray_direction((*found)[size_t(l)]));
+  }
+  std::vector<Eigen::Vector3d> head_points, world_points;
+  for (int l = 17; l < kLandmarkCount; ++l) {  // the jaw line is a silhouette, not a point
+    if (int(rays[size_t(l)].size()) < std::max(2, min_views)) continue;
+    head_points.push_back(neutral.row(model.landmark_vertices[size_t(l)]).cast<double>().transpose());
+    world_points.push_back(closest_to_rays(rays[size_t(l)]));
+  }
+  if (head_points.size() < 6) return std::nullopt;
+  return align(head_points, world_points);
+}
+
+// The face looks towards the cameras, upright as they are on average; its
+// front lies on the part of the scan facing them.
+RigidTransform pose_from_rig(const HeadModel& model, const Vertices& neutral, const Mesh& scan,
+                             const std::vector<Camera>& cameras) {
+  Eigen::Vector3d eyes = Eigen::Vector3d::Zero(), up = Eigen::Vector3d::Zero();
+  for (const Camera& c : cameras) {
+    eyes += c.center();
+    up -= c.world_to_camera.R.row(1).transpose();  // image y points down
+  }
+  eyes /= double(cameras.size());
+  Eigen::Vector3d scan_centre = Eigen::Vector3d::Zero();
+  for (int v = 0; v < scan.num_vertices(); ++v) scan_centre += scan.positions.row(v).cast<double>().transpose();
+  scan_centre /= double(std::max(1, scan.num_vertices()));
+  const Eigen::Vector3d forward = (eyes - scan_centre).normalized();
+  up = (up - up.dot(forward) * forward).normalized();
+  RigidTransform pose;
+  pose.R.col(0) = up.cross(forward);
+  pose.R.col(1) = up;
+  pose.R.col(2) = forward;
+
+  const Vertices normals = scan.vertex_normals();
+  Eigen::Vector3d front = Eigen::Vector3d::Zero();
+  int count = 0;
+  for (int v = 0; v < scan.num_vertices(); ++v)
+    if (normals.row(v).cast<double>().dot(forward) > kFrontFacingCosine)
+      front += scan.positions.row(v).cast<double>().transpose(), ++count;
+  if (count == 0) throw Error("the scan has no surface facing the cameras");
+  Eigen::Vector3d face = Eigen::Vector3d::Zero();
+  for (int v : model.fit_vertices) face += neutral.row(v).cast<double>().transpose();
+  face /= double(model.fit_vertices.size());
+  pose.t = front / count - pose.R * face;
+  return pose;
+}
+
+}  // namespace
+
+RigidTransform initial_pose(const HeadModel& model, const Vertices& neutral, const FrameObservation& frame,
+                            const std::vector<Camera>& cameras, const Options& options,
+                            const LandmarkDetector* landmarks) {
+  std::optional<RigidTransform> pose;
+  if (landmarks) pose = pose_from_landmarks(model, neutral, frame, cameras, *landmarks, options.landmarks.min_views);
+  if (!pose) pose = pose_from_rig(model, neutral, *frame.scan, cameras);
+
+  const SurfaceQuery scan(*frame.scan);
+  std::vector<RigidTransform> poses = {*pose};
+  std::vector<double> none;
+  for (int it = 0; it < kRigidIcpIterations; ++it) {
+    Vertices world = neutral;
+    for (int v = 0; v < world.rows(); ++v)
+      world.row(v) = poses[0].apply(neutral.row(v).cast<double>().transpose()).cast<float>().transpose();
+    const double bound = kRigidIcpStartDistanceM + (options.surface.max_distance_m - kRigidIcpStartDistanceM) *
+                                                       double(it) / (kRigidIcpIterations - 1);
+    CoefficientProblem problem;
+    problem.base = &neutral;
+    problem.fit_coefficients = false;
+    problem.frames.push_back({surface_targets(posed_model(model, world), model.pose_vertices, scan, bound,
+                                              options.surface),
+                              {}});
+    problem.frames[0].surface.scale.robust_scale = options.surface.robust_scale;
+    problem.iterations = options.coefficients.solver_iterations;
+    problem.threads = options.threads;
+    if (problem.frames[0].surface.targets.size() < 50)
+      throw Error("the scan does not meet the head model near where the head should be (" +
+                  std::to_string(problem.frames[0].surface.targets.size()) + " correspondences)");
+    fit_coefficients(problem, poses, none);
+  }
+  return poses[0];
+}
+
+}  // namespace tega::tracking

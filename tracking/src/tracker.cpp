@@ -1,0 +1,280 @@
+#include "tega/tracking/tracker.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "frame_targets.h"
+#include "rigid_alignment.h"
+#include "tega/core/error.h"
+
+namespace tega::tracking {
+namespace {
+
+constexpr double kDegree = M_PI / 180;
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+Vertices with_shapes(Vertices base, const std::vector<Vertices>& shapes, const std::vector<double>& coefficients) {
+  for (size_t k = 0; k < std::min(shapes.size(), coefficients.size()); ++k)
+    if (coefficients[k] != 0) base += static_cast<float>(coefficients[k]) * shapes[k];
+  return base;
+}
+
+Vertices posed(const Vertices& head, const RigidTransform& pose) {
+  Vertices world(head.rows(), 3);
+  const Eigen::Matrix3f R = pose.R.cast<float>();
+  const Eigen::RowVector3f t = pose.t.cast<float>().transpose();
+  for (Eigen::Index v = 0; v < head.rows(); ++v) world.row(v) = head.row(v) * R.transpose() + t;
+  return world;
+}
+
+// The ICP bound of iteration `it` of `count`: from max_distance_m down to final_distance_m.
+double distance_bound(const SurfaceTermOptions& o, int it, int count) {
+  if (count <= 1) return o.final_distance_m;
+  return o.max_distance_m + (o.final_distance_m - o.max_distance_m) * double(it) / double(count - 1);
+}
+
+CorrectionProblem correction_problem(const HeadModel& model, const Options& options,
+                                     const std::vector<std::pair<int, int>>& edges, const std::vector<Camera>& cameras) {
+  const CorrectionOptions& o = options.corrections;
+  CorrectionProblem p;
+  p.vertices = &model.skin_vertices;
+  p.edges = &edges;
+  p.smoothness = {o.smoothness_sigma_m, o.weight, 0};
+  // The magnitude and temporal priors share the coefficient priors' weight.
+  p.magnitude = {o.magnitude_sigma_m, options.coefficients.weight, 0};
+  p.temporal = {o.temporal_sigma_m, options.coefficients.weight, 0};
+  p.cameras = &cameras;
+  p.threads = options.threads;
+  return p;
+}
+
+}  // namespace
+
+Vertices pose_vertices(const HeadModel& model, const SubjectIdentity& subject, const HeadState& state) {
+  Vertices head = with_shapes(subject.neutral, model.shapes.expression_deltas, state.expression);
+  if (state.corrections.rows() == head.rows()) head += state.corrections;
+  return posed(head, state.head_to_world);
+}
+
+SubjectIdentity fit_identity(const HeadModel& model, const std::vector<FrameObservation>& frames,
+                             const std::vector<Camera>& cameras, const Options& options,
+                             const LandmarkDetector* landmarks) {
+  if (frames.empty()) throw Error("fitting the identity needs at least one frame");
+  const Vertices& mean = model.shapes.neutral.positions;
+  std::vector<std::unique_ptr<SurfaceQuery>> scans;
+  std::vector<RigidTransform> poses;
+  for (const auto& frame : frames) {
+    scans.push_back(std::make_unique<SurfaceQuery>(*frame.scan));
+    poses.push_back(initial_pose(model, mean, frame, cameras, options, landmarks));
+  }
+  const size_t F = frames.size();
+  SubjectIdentity subject;
+  subject.coefficients.assign(model.shapes.identity_deltas.size(), 0.0);
+  const auto frame_targets = [&](const Vertices& head, double bound, const std::vector<int>& vertices) {
+    std::vector<FrameTargets> targets(F);
+    for (size_t f = 0; f < F; ++f) {
+      const PosedModel p = posed_model(model, posed(head, poses[f]));
+      targets[f].surface = surface_targets(p, vertices, *scans[f], bound, options.surface);
+      if (landmarks)
+        targets[f].images.push_back(
+            landmark_targets(model, p, frames[f], cameras, *scans[f], *landmarks, options.landmarks));
+    }
+    return targets;
+  };
+
+  const int iterations = std::max(2, options.icp_iterations);
+  for (int it = 0; it < iterations; ++it) {
+    const Vertices head = with_shapes(mean, model.shapes.identity_deltas, subject.coefficients);
+    CoefficientProblem p;
+    p.base = &mean;
+    p.basis = &model.shapes.identity_deltas;
+    p.prior_sigma = options.coefficients.identity_sigma;
+    p.prior_scale = {1, options.coefficients.weight, 0};
+    p.cameras = &cameras;
+    p.frames = frame_targets(head, distance_bound(options.surface, it, iterations), model.fit_vertices);
+    p.iterations = options.coefficients.solver_iterations;
+    p.threads = options.threads;
+    fit_coefficients(p, poses, subject.coefficients);
+  }
+  subject.neutral = with_shapes(mean, model.shapes.identity_deltas, subject.coefficients);
+
+  if (options.corrections.enabled) {
+    const auto edges = edges_between(model.shapes.neutral.faces, model.skin_vertices);
+    Vertices detail = Vertices::Zero(subject.neutral.rows(), 3);
+    for (int it = 0; it < std::max(1, options.corrections.iterations); ++it) {
+      CorrectionProblem p = correction_problem(model, options, edges, cameras);
+      p.base = &subject.neutral;
+      p.poses = poses;
+      p.frames = frame_targets(subject.neutral + detail, options.surface.final_distance_m, model.fit_vertices);
+      fit_corrections(p, detail);
+    }
+    // The detail is the subject's shape, not a turn of the head: what of it
+    // is rigid goes, so that head space stays the model's.
+    std::vector<Eigen::Vector3d> detailed, shaped;
+    for (int v : model.skin_vertices) {
+      detailed.push_back((subject.neutral.row(v) + detail.row(v)).cast<double>().transpose());
+      shaped.push_back(subject.neutral.row(v).cast<double>().transpose());
+    }
+    const RigidTransform rigid_part = align(detailed, shaped);
+    subject.neutral = posed(subject.neutral + detail, rigid_part);
+  }
+  return subject;
+}
+
+struct TakeTracker::Previous {
+  HeadState state;
+  PosedModel posed;
+  std::unique_ptr<SurfaceQuery> scan;  // null: no flow to the next frame
+  std::vector<Image8> images;
+};
+
+TakeTracker::TakeTracker(const HeadModel& model, const SubjectIdentity& subject, std::vector<Camera> cameras,
+                         const Options& options, const LandmarkDetector* landmarks)
+    : model_(model),
+      subject_(subject),
+      cameras_(std::move(cameras)),
+      options_(options),
+      landmarks_(landmarks),
+      skin_edges_(edges_between(model.shapes.neutral.faces, model.skin_vertices)) {}
+
+TakeTracker::~TakeTracker() = default;
+
+FrameFit TakeTracker::track(const FrameObservation& frame) {
+  if (!frame.scan) throw Error("a frame to track needs its scan");
+  const SurfaceQuery scan(*frame.scan);
+  const Options& o = options_;
+  const size_t E = model_.shapes.expression_deltas.size();
+
+  FrameFit fit;
+  HeadState& state = fit.state;
+  if (previous_) {
+    state = previous_->state;
+  } else {
+    state.head_to_world = initial_pose(model_, subject_.neutral, frame, cameras_, o, landmarks_);
+    state.expression.assign(E, 0.0);
+    state.corrections = Vertices::Zero(subject_.neutral.rows(), 3);
+  }
+  const Vertices base = subject_.neutral + state.corrections;
+
+  auto start = std::chrono::steady_clock::now();
+  std::vector<Term<ImageTarget>> image_terms;
+  const bool has_images = !frame.images.empty();
+  Term<ImageTarget> flow, landmarks;
+  if (o.flow.enabled && has_images && previous_ && previous_->scan)
+    flow = flow_targets(model_, previous_->posed, *previous_->scan, previous_->images, frame.images, cameras_, o.flow);
+  if (landmarks_ && has_images)
+    landmarks = landmark_targets(model_, posed_model(model_, pose_vertices(model_, subject_, state)), frame, cameras_,
+                                 scan, *landmarks_, o.landmarks);
+  if (!flow.targets.empty()) image_terms.push_back(flow);
+  if (!landmarks.targets.empty()) image_terms.push_back(landmarks);
+  fit.timings.image_terms_s = seconds_since(start);
+  start = std::chrono::steady_clock::now();
+
+  // Coefficient priors: towards neutral, and towards the previous frame's
+  // values when there is one (the product of the two Gaussians).
+  const CoefficientOptions& co = o.coefficients;
+  std::vector<double> prior_mean(E, 0.0);
+  double prior_sigma = co.expression_sigma;
+  if (previous_) {
+    const double a = 1 / (co.expression_sigma * co.expression_sigma);
+    const double b = 1 / (co.expression_temporal_sigma * co.expression_temporal_sigma);
+    for (size_t j = 0; j < E; ++j) prior_mean[j] = b * previous_->state.expression[j] / (a + b);
+    prior_sigma = 1 / std::sqrt(a + b);
+  }
+  std::vector<RigidTransform> poses = {state.head_to_world};
+  for (int it = 0; it < o.icp_iterations; ++it) {
+    const PosedModel now = posed_model(model_, pose_vertices(model_, subject_, state));
+    // The first iteration fixes the pose on what no expression moves.
+    const bool pose_only = it == 0;
+    CoefficientProblem p;
+    p.base = &base;
+    p.basis = &model_.shapes.expression_deltas;
+    p.lower.assign(E, 0.0);
+    p.upper.assign(E, 1.0);
+    p.prior_mean = prior_mean;
+    p.prior_sigma = prior_sigma;
+    p.prior_scale = {1, co.weight, 0};
+    p.cameras = &cameras_;
+    p.frames.push_back({surface_targets(now, pose_only ? model_.pose_vertices : model_.fit_vertices, scan,
+                                        distance_bound(o.surface, it, o.icp_iterations), o.surface),
+                        pose_only ? std::vector<Term<ImageTarget>>{} : image_terms});
+    if (previous_) p.pose_priors.push_back(&previous_->state.head_to_world);
+    p.rotation_sigma_rad = co.rotation_temporal_sigma_deg * kDegree;
+    p.translation_sigma_m = co.translation_temporal_sigma_m;
+    p.iterations = co.solver_iterations;
+    p.threads = o.threads;
+    p.fit_coefficients = !pose_only;
+    fit_coefficients(p, poses, state.expression);
+    state.head_to_world = poses[0];
+  }
+  fit.timings.coefficients_s = seconds_since(start);
+
+  start = std::chrono::steady_clock::now();
+  if (o.corrections.enabled) {
+    const Vertices shaped = with_shapes(subject_.neutral, model_.shapes.expression_deltas, state.expression);
+    for (int it = 0; it < std::max(1, o.corrections.iterations); ++it) {
+      const PosedModel now = posed_model(model_, pose_vertices(model_, subject_, state));
+      CorrectionProblem p = correction_problem(model_, o, skin_edges_, cameras_);
+      p.base = &shaped;
+      p.previous = previous_ ? &previous_->state.corrections : nullptr;
+      p.poses = {state.head_to_world};
+      p.frames.push_back(
+          {surface_targets(now, model_.fit_vertices, scan, o.surface.final_distance_m, o.surface), image_terms});
+      fit_corrections(p, state.corrections);
+    }
+  }
+
+  fit.timings.corrections_s = seconds_since(start);
+  fit.vertices = pose_vertices(model_, subject_, state);
+  surface_residuals(posed_model(model_, fit.vertices), model_, scan, o.surface, fit.residuals);
+  fit.residuals.flow_rms_px = reprojection_rms(flow, fit.vertices, cameras_);
+  fit.residuals.flow_count = int(flow.targets.size());
+  fit.residuals.landmark_rms_px = reprojection_rms(landmarks, fit.vertices, cameras_);
+  fit.residuals.landmark_count = int(landmarks.targets.size());
+  return fit;
+}
+
+std::optional<std::string> TakeTracker::rejection(const FrameFit& fit) const {
+  const FrameResiduals& r = fit.residuals;
+  char reason[160];
+  if (r.inlier_fraction < options_.min_inlier_fraction) {
+    std::snprintf(reason, sizeof reason, "only %.0f %% of the face lies within %.1f mm of the scan (minimum %.0f %%)",
+                  100 * r.inlier_fraction, 1000 * options_.surface.final_distance_m,
+                  100 * options_.min_inlier_fraction);
+    return reason;
+  }
+  if (r.surface_median_m > options_.max_median_distance_m) {
+    std::snprintf(reason, sizeof reason, "the face lies %.2f mm from the scan (median; at most %.2f mm)",
+                  1000 * r.surface_median_m, 1000 * options_.max_median_distance_m);
+    return reason;
+  }
+  return std::nullopt;
+}
+
+void TakeTracker::accept(const FrameFit& fit, const FrameObservation& frame) {
+  previous_ = std::make_unique<Previous>();
+  previous_->state = fit.state;
+  previous_->posed = posed_model(model_, fit.vertices);
+  if (!frame.images.empty() && frame.scan) {
+    previous_->scan = std::make_unique<SurfaceQuery>(*frame.scan);
+    previous_->images = frame.images;
+  }
+}
+
+void TakeTracker::resume_from(const HeadState& state) {
+  previous_ = std::make_unique<Previous>();
+  previous_->state = state;
+  previous_->posed = posed_model(model_, pose_vertices(model_, subject_, state));
+}
+
+void TakeTracker::break_sequence() {
+  if (!previous_) return;
+  previous_->scan.reset();
+  previous_->images.clear();
+}
+
+}  // namespace tega::tracking

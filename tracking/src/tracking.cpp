@@ -1,0 +1,222 @@
+#include "tega/tracking/tracking.h"
+
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "frame_record.h"
+#include "report.h"
+#include "tega/core/error.h"
+#include "tega/core/files.h"
+#include "tega/core/log.h"
+#include "tega/core/options.h"
+#include "tega/core/progress.h"
+#include "tega/core/rig.h"
+#include "tega/core/take.h"
+#include "tega/core/thread_pool.h"
+#include "tega/mvs/debayer.h"
+#include "tega/mvs/frame_views.h"
+#include "tega/tracking/landmarks.h"
+
+namespace tega::tracking {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string frame_name(int frame, const char* extension) {
+  char name[32];
+  std::snprintf(name, sizeof name, "%06d%s", frame, extension);
+  return name;
+}
+
+// The rig's cameras in the take's order; every camera of the take must be in the rig.
+std::vector<Camera> take_cameras(const TakeInfo& take, const Rig& rig, const fs::path& rig_file) {
+  std::vector<Camera> cameras;
+  for (const auto& name : take.cameras) {
+    const auto it = std::find_if(rig.cameras.begin(), rig.cameras.end(), [&](const Camera& c) { return c.name == name; });
+    if (it == rig.cameras.end())
+      throw Error(rig_file, "has no camera " + name + ", which take " + take.name + " records");
+    cameras.push_back(*it);
+  }
+  return cameras;
+}
+
+// The photos of a frame as recorded, RGB; an empty image where a camera has none.
+std::vector<Image8> frame_photos(const TakeInfo& take, int frame, ThreadPool& pool) {
+  std::vector<Image8> photos(take.cameras.size());
+  pool.parallel_for(0, int64_t(take.cameras.size()), [&](int64_t c) {
+    const std::string& camera = take.cameras[size_t(c)];
+    if (!take.has_image(camera, frame)) return;
+    const Image8 raw = read_image_u8(take.image_path(camera, frame));
+    photos[size_t(c)] = take.pixel_format.rfind("Bayer", 0) == 0 ? mvs::debayer(raw, take.pixel_format) : mvs::rgb_of(raw);
+  });
+  return photos;
+}
+
+struct TakeContext {
+  const TakeInfo& take;
+  const std::vector<Camera>& cameras;
+  const HeadModel& model;
+  const SubjectIdentity& subject;
+  const LandmarkDetector* landmarks;
+  fs::path meshes;  // MESHES/<take>
+  fs::path out;     // TRACKED/<take>
+  std::string made_with;
+};
+
+bool needs_photos(const Options& o, const LandmarkDetector* landmarks) { return o.flow.enabled || landmarks; }
+
+void track_take(const TakeContext& t, const Options& options, TrackSummary& summary, ThreadPool& pool) {
+  const fs::path options_file = t.out / "made_with.yaml";
+  if (fs::exists(t.out / "track.json") && fs::exists(options_file) && read_text_file(options_file) == t.made_with) {
+    logging::info("track: take %s is tracked already with these options", t.take.name.c_str());
+    summary.frames_kept += t.take.frames;
+    return;
+  }
+  // Frames written with other options or another identity are redone.
+  if (fs::exists(t.out) && (!fs::exists(options_file) || read_text_file(options_file) != t.made_with)) remove_tree(t.out);
+  fs::create_directories(t.out);
+  write_text_atomic(options_file, t.made_with);
+
+  TakeTracker tracker(t.model, t.subject, t.cameras, options, t.landmarks);
+  std::vector<FrameRecord> records;
+  Progress progress("track " + t.take.name, t.take.frames, "frames");
+  bool follows = false;  // the next frame follows an accepted one
+  for (int frame = 0; frame < t.take.frames; ++frame) {
+    if (auto done = read_frame_record(t.out, frame, t.model, &t.subject)) {
+      if (done->record.status == "tracked") {
+        tracker.resume_from(done->state);
+        follows = false;  // no photos kept: no flow into the next frame
+      }
+      records.push_back(done->record);
+      ++summary.frames_kept;
+      progress.advance();
+      continue;
+    }
+    FrameRecord record;
+    record.frame = frame;
+    const fs::path scan_file = t.meshes / frame_name(frame, ".ply");
+    if (!fs::exists(scan_file)) {
+      record.status = "skipped";
+      record.reason = "no scan: " + scan_file.string() + " is missing";
+      logging::warn("track: take %s, frame %d skipped: %s", t.take.name.c_str(), frame, record.reason.c_str());
+      write_frame_record(t.out, record, nullptr, t.model);
+      records.push_back(record);
+      tracker.break_sequence();
+      follows = false;
+      ++summary.frames_skipped;
+      progress.advance();
+      continue;
+    }
+    const Mesh scan = read_mesh(scan_file);
+    FrameObservation observation{&scan, {}};
+    if (needs_photos(options, t.landmarks)) observation.images = frame_photos(t.take, frame, pool);
+    if (!follows) tracker.break_sequence();
+    FrameFit fit = tracker.track(observation);
+    record.state = fit.state;
+    record.residuals = fit.residuals;
+    if (auto reason = tracker.rejection(fit)) {
+      record.status = "failed";
+      record.reason = *reason;
+      logging::warn("track: take %s, frame %d failed: %s", t.take.name.c_str(), frame, reason->c_str());
+      write_frame_record(t.out, record, nullptr, t.model);
+      tracker.break_sequence();
+      follows = false;
+      ++summary.frames_failed;
+    } else {
+      record.status = "tracked";
+      write_frame_record(t.out, record, &fit.vertices, t.model);
+      tracker.accept(fit, observation);
+      follows = true;
+      ++summary.frames_tracked;
+    }
+    records.push_back(record);
+    progress.advance();
+  }
+  progress.finish();
+  write_take_report(t.out / "report", records, t.take, t.cameras, t.model, options.report_overlays, pool);
+  nlohmann::json summary_json;
+  summary_json["take"] = t.take.name;
+  summary_json["frames"] = t.take.frames;
+  int tracked = 0;
+  for (const auto& r : records) tracked += r.status == "tracked";
+  summary_json["tracked"] = tracked;
+  summary_json["frames_not_tracked"] = nlohmann::json::array();
+  for (const auto& r : records)
+    if (r.status != "tracked") summary_json["frames_not_tracked"].push_back({{"frame", r.frame}, {"status", r.status}, {"reason", r.reason}});
+  write_text_atomic(t.out / "track.json", summary_json.dump(2) + "\n");
+}
+
+// The first frames of the first take, each with its scan and photos.
+SubjectIdentity identity_of(const TrackRequest& request, const TakeInfo& first, const std::vector<Camera>& cameras,
+                            const HeadModel& model, const Options& options, const LandmarkDetector* landmarks,
+                            ThreadPool& pool) {
+  std::vector<Mesh> scans;
+  std::vector<std::vector<Image8>> photos;
+  for (int frame : options.identity_frames) {
+    const fs::path scan_file = request.meshes / first.name / frame_name(frame, ".ply");
+    if (!fs::exists(scan_file))
+      throw Error(scan_file, "is missing: the identity is fitted to frame " + std::to_string(frame) + " of take " +
+                                 first.name + " (identity_frames)");
+    scans.push_back(read_mesh(scan_file));
+    photos.push_back(landmarks ? frame_photos(first, frame, pool) : std::vector<Image8>{});
+  }
+  std::vector<FrameObservation> frames;
+  for (size_t i = 0; i < scans.size(); ++i) frames.push_back({&scans[i], photos[i]});
+  logging::info("track: fitting the subject's identity to %zu frame(s) of take %s", frames.size(), first.name.c_str());
+  return fit_identity(model, frames, cameras, options, landmarks);
+}
+
+}  // namespace
+
+TrackSummary track_capture(const TrackRequest& request, const Options& options) {
+  const CaptureInfo capture = read_capture(request.capture);
+  const fs::path rig_file = !request.rig.empty() ? request.rig
+                            : !capture.rig.empty() ? capture.root / capture.rig
+                                                   : capture.root / "rig.json";
+  const Rig rig = read_rig_json(rig_file);
+  std::vector<std::string> takes = request.takes;
+  if (takes.empty())
+    for (const auto& take : capture.takes)
+      if (take.kind == "performance") takes.push_back(take.name);
+  if (takes.empty()) throw Error(request.capture / "capture.json", "lists no performance take to track");
+  for (const auto& name : takes)
+    if (!fs::is_directory(request.meshes / name))
+      throw Error(request.meshes / name, "is missing: take " + name + " has no meshes (run tega mvs first)");
+
+  if (options.model.empty()) throw Error("track: no head model: set the model option (tega track --model DIR)");
+  const HeadModel model = load_head_model(options.model, options.model_metres_per_unit);
+  std::unique_ptr<LandmarkDetector> landmarks;
+  if (!options.landmarks.model.empty()) landmarks = std::make_unique<LandmarkDetector>(options.landmarks.model);
+  ThreadPool pool(options.threads);
+  fs::create_directories(request.out);
+
+  const TakeInfo first = read_take(capture.root / "takes" / takes.front());
+  const fs::path identity_file = request.out / "identity.json";
+  SubjectIdentity subject;
+  if (!options.identity.empty()) {
+    subject = read_identity(options.identity, model);
+    if (fs::absolute(options.identity) != fs::absolute(identity_file)) write_identity(subject, model, identity_file);
+  } else if (fs::exists(identity_file) && fs::exists(request.out / "identity_options.yaml") &&
+             read_text_file(request.out / "identity_options.yaml") == options_to_yaml(options)) {
+    subject = read_identity(identity_file, model);
+  } else {
+    subject = identity_of(request, first, take_cameras(first, rig, rig_file), model, options, landmarks.get(), pool);
+    write_identity(subject, model, identity_file);
+    write_text_atomic(request.out / "identity_options.yaml", options_to_yaml(options));
+  }
+
+  const std::string made_with = options_to_yaml(options) + "# identity\n" + read_text_file(identity_file) +
+                                "# rig\n" + read_text_file(rig_file);
+  TrackSummary summary;
+  for (const auto& name : takes) {
+    const TakeInfo take = read_take(capture.root / "takes" / name);
+    const std::vector<Camera> cameras = take_cameras(take, rig, rig_file);
+    logging::info("track: take %s, %d frames, %zu cameras", name.c_str(), take.frames, cameras.size());
+    track_take({take, cameras, model, subject, landmarks.get(), request.meshes / name, request.out / name, made_with},
+               options, summary, pool);
+    ++summary.takes;
+  }
+  return summary;
+}
+
+}  // namespace tega::tracking
