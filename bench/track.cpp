@@ -13,6 +13,7 @@
 #include "tega/core/take.h"
 #include "tega/core/thread_pool.h"
 #include "tega/synth/virtual_studio.h"
+#include "tega/tracking/evaluation.h"
 #include "tega/tracking/head_model.h"
 #include "tega/tracking/landmarks.h"
 #include "tega/tracking/tracker.h"
@@ -42,6 +43,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Time per frame of tega's template tracking (ICT-FaceKit topology)."};
   std::string model_dir = "../shared/data/ict-facekit", capture_dir, meshes_dir, landmarks;
   int frames = 8, width = 512, height = 384, threads = 2;
+  bool no_flow = false;
   app.add_option("--model", model_dir, "The ICT-FaceKit directory.");
   app.add_option("--capture", capture_dir, "A virtual-studio capture to track (default: render one).");
   app.add_option("--meshes", meshes_dir, "Its MVS meshes (MESHES/expressions/<frame>.ply; default: the true meshes).");
@@ -50,6 +52,7 @@ int main(int argc, char** argv) {
   app.add_option("--height", height, "Image height of the rendered capture.");
   app.add_option("--threads", threads, "Worker threads (the target machine has 2 cores).");
   app.add_option("--landmarks", landmarks, "A dlib 68-point shape predictor for the landmark term.");
+  app.add_flag("--no-flow", no_flow, "Track without the optical-flow term.");
   CLI11_PARSE(app, argc, argv);
 
   fs::path capture = capture_dir;
@@ -73,6 +76,7 @@ int main(int argc, char** argv) {
   tracking::Options options;
   options.threads = threads;
   options.landmarks.model = landmarks;
+  options.flow.enabled = !no_flow;
   const tracking::HeadModel model = tracking::load_head_model(model_dir, options.model_metres_per_unit);
   const std::unique_ptr<tracking::LandmarkDetector> detector =
       landmarks.empty() ? nullptr : std::make_unique<tracking::LandmarkDetector>(landmarks);
@@ -92,10 +96,11 @@ int main(int argc, char** argv) {
   std::printf("identity fit: %.2f s (once per subject)\n", seconds_since(start));
 
   tracking::TakeTracker tracker(model, subject, rig.cameras, options, detector.get());
-  std::printf("%-6s %10s %14s %14s %14s %10s\n", "frame", "scan (s)", "image terms", "pose+expr", "corrections",
-              "total (s)");
+  std::printf("%-6s %10s %12s %12s %12s %10s %12s %12s\n", "frame", "scan faces", "image terms", "pose+expr",
+              "corrections", "total (s)", "flow points", "flow rms px");
   double total = 0;
   int counted = 0;
+  std::vector<tracking::TrackedFrame> scored;
   for (int frame = 0; frame < take.frames; ++frame) {
     const Mesh scan = scan_of(capture, meshes_dir, fine_topology, frame);
     const tracking::FrameObservation observation{&scan, photos(frame)};
@@ -103,10 +108,22 @@ int main(int argc, char** argv) {
     const tracking::FrameFit fit = tracker.track(observation);
     const double seconds = seconds_since(start);
     tracker.accept(fit, observation);
-    std::printf("%-6d %10d %14.2f %14.2f %14.2f %10.2f\n", frame, scan.num_faces(), fit.timings.image_terms_s,
-                fit.timings.coefficients_s, fit.timings.corrections_s, seconds);
+    tracking::TrackedFrame t{frame, fit.vertices, fit.state.head_to_world.R, {}};
+    for (size_t k = 0; k < fit.state.expression.size(); ++k)
+      t.expression[model.shapes.expression_names[k]] = fit.state.expression[k];
+    scored.push_back(std::move(t));
+    std::printf("%-6d %10d %12.2f %12.2f %12.2f %10.2f %12d %12.2f\n", frame, scan.num_faces(), fit.timings.image_terms_s,
+                fit.timings.coefficients_s, fit.timings.corrections_s, seconds, fit.residuals.flow_count,
+                fit.residuals.flow_rms_px);
     if (frame > 0) total += seconds, ++counted;  // frame 0 also finds the first pose
   }
   if (counted) std::printf("mean over frames 1..%d: %.2f s per frame (%d threads)\n", take.frames - 1, total / counted, threads);
+  if (fs::exists(capture / "ground_truth")) {
+    const tracking::TrackScores s = tracking::score_frames(scored, capture, "expressions");
+    std::printf("against the truth: vertex error median %.3f mm, p95 %.3f mm; rotation error median %.3f deg, "
+                "max %.3f deg\n",
+                1000 * s.vertex_median_m, 1000 * s.vertex_p95_m, s.rotation_median_deg, s.rotation_max_deg);
+    for (const auto& [name, r] : s.correlation) std::printf("  %-16s r = %.3f\n", name.c_str(), r);
+  }
   return 0;
 }

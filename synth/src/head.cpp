@@ -18,8 +18,9 @@ int polygon_of(const Mesh& mesh, int triangle) {
   return mesh.triangle_polygon.empty() ? triangle : mesh.triangle_polygon[triangle];
 }
 
-// Removes the triangles of polygons [first, last] and the vertices only they used.
-void remove_polygons(BlendshapeModel& model, int first, int last) {
+// Removes the triangles of polygons [first, last] and the vertices only they
+// used; returns the kept vertices' old indices.
+std::vector<int> remove_polygons(BlendshapeModel& model, int first, int last) {
   Mesh& m = model.neutral;
   std::vector<int> kept_faces;
   for (int f = 0; f < m.num_faces(); ++f) {
@@ -51,6 +52,18 @@ void remove_polygons(BlendshapeModel& model, int first, int last) {
   for (auto& d : model.identity_deltas) d = compact(d);
   for (auto& d : model.expression_deltas) d = compact(d);
   m = std::move(out);
+  return kept_vertices;
+}
+
+std::vector<std::pair<int, int>> runs_of(const std::vector<int>& sorted) {
+  std::vector<std::pair<int, int>> runs;
+  for (int v : sorted) {
+    if (!runs.empty() && runs.back().second + 1 == v)
+      runs.back().second = v;
+    else
+      runs.emplace_back(v, v);
+  }
+  return runs;
 }
 
 Eigen::Vector3d centroid(const Mesh& mesh, const std::vector<int>& vertices) {
@@ -73,7 +86,7 @@ Head load_head(const std::filesystem::path& directory, double metres_per_unit,
                                  std::to_string(head.model.num_vertices()) +
                                  " vertices, not ICT-FaceKit's topology): set head_eyeball_polygons");
     // The overlays lie after the eyeballs, so removing them keeps the eyeball range.
-    remove_polygons(head.model, kIctOverlayFirst, kIctOverlayLast);
+    head.source_vertex_runs = runs_of(remove_polygons(head.model, kIctOverlayFirst, kIctOverlayLast));
     first = kIctEyeballFirst;
     last = kIctEyeballLast;
   } else if (eyeball_polygons.size() == 2 && eyeball_polygons[0] <= eyeball_polygons[1]) {

@@ -46,6 +46,7 @@ void write_head_ground_truth(const std::filesystem::path& dir, const Head& head,
       {"fine_note", "fine meshes: fine_topology.obj's faces and UVs; its triangles come in runs of "
                     "4^fine_subdivisions, one run per triangle of template.obj, in that order"},
       {"eyeball_faces", head.eyeball_faces},
+      {"source_vertex_runs", head.source_vertex_runs},
       {"expressions", head.model.expression_names},
       {"eye_left", vec(head.frame.eye_left)},
       {"eye_right", vec(head.frame.eye_right)},

@@ -51,41 +51,54 @@ double pearson(const std::vector<double>& a, const std::vector<double>& b) {
   return saa > 0 && sbb > 0 ? sab / std::sqrt(saa * sbb) : 0;
 }
 
+// The model's vertex for each of the studio template's (head.json's source_vertex_runs).
+std::vector<int> model_vertex_of(const fs::path& capture, int studio_vertices) {
+  const fs::path file = capture / "ground_truth" / "head" / "head.json";
+  const auto head = read_json(file);
+  std::vector<int> model_vertex;
+  for (const auto& run : head.value("source_vertex_runs", nlohmann::json::array()))
+    for (int v = run.at(0).get<int>(); v <= run.at(1).get<int>(); ++v) model_vertex.push_back(v);
+  if (model_vertex.empty())
+    for (int v = 0; v < studio_vertices; ++v) model_vertex.push_back(v);
+  if (int(model_vertex.size()) != studio_vertices)
+    throw Error(file, "source_vertex_runs cover " + std::to_string(model_vertex.size()) + " vertices; template.obj has " +
+                          std::to_string(studio_vertices));
+  return model_vertex;
+}
+
 }  // namespace
 
-TrackScores score_against_studio(const fs::path& tracked_take, const fs::path& capture, const std::string& take) {
+TrackScores score_frames(const std::vector<TrackedFrame>& tracked, const fs::path& capture, const std::string& take) {
   const mvs::StudioTruth truth = mvs::load_studio_truth(capture, take, 0);
   const auto frames = read_json(capture / "ground_truth" / take / "frames.json");
   const Mesh coarse = read_obj(capture / "ground_truth" / "head" / "template.obj");
+  const std::vector<int> model_vertex = model_vertex_of(capture, coarse.num_vertices());
+  std::map<int, const nlohmann::json*> truth_frames;
+  for (const auto& f : frames.at("frames")) truth_frames[f.at("index").get<int>()] = &f;
   TrackScores scores;
   std::vector<double> errors, rotations;
   std::map<std::string, std::pair<std::vector<double>, std::vector<double>>> series;  // truth, tracked
-  for (const auto& truth_frame : frames.at("frames")) {
-    const int frame = truth_frame.at("index");
+  for (const TrackedFrame& t : tracked) {
+    if (!truth_frames.count(t.frame)) throw Error(capture / "ground_truth" / take / "frames.json", "has no frame " + std::to_string(t.frame));
+    const nlohmann::json& truth_frame = *truth_frames.at(t.frame);
     char name[32];
-    std::snprintf(name, sizeof name, "%06d", frame);
-    const fs::path record_file = tracked_take / (std::string(name) + ".json");
-    if (!fs::exists(record_file)) continue;
-    const auto record = read_json(record_file);
-    if (record.at("status") != "tracked") continue;
-    ++scores.frames;
-    const Vertices tracked = read_vertices_bin(tracked_take / (std::string(name) + ".bin"));
-    const Vertices true_mesh =
-        read_vertices_bin(capture / "ground_truth" / take / "coarse" / (std::string(name) + ".bin"), coarse.num_vertices());
+    std::snprintf(name, sizeof name, "%06d.bin", t.frame);
+    const Vertices true_mesh = read_vertices_bin(capture / "ground_truth" / take / "coarse" / name, coarse.num_vertices());
     for (int v : truth.face_vertices) {
-      if (v >= tracked.rows()) throw Error(tracked_take, "has fewer vertices than the studio's face region needs");
-      errors.push_back((tracked.row(v) - true_mesh.row(v)).cast<double>().norm());
+      const int m = model_vertex[size_t(v)];
+      if (m >= t.vertices.rows()) throw Error("a tracked mesh has fewer vertices than the studio's face region needs");
+      errors.push_back((t.vertices.row(m) - true_mesh.row(v)).cast<double>().norm());
     }
-    const Eigen::Matrix3d R = rotation_of(record.at("head_to_world"));
     const Eigen::Matrix3d R_true = rotation_of(truth_frame.at("head_to_world"));
-    rotations.push_back(Eigen::AngleAxisd(R.transpose() * R_true).angle() * 180 / M_PI);
+    rotations.push_back(Eigen::AngleAxisd(t.head_rotation.transpose() * R_true).angle() * 180 / M_PI);
     for (const auto& [expression, value] : truth_frame.at("expression").items()) {
       auto& [truth_values, tracked_values] = series[expression];
       truth_values.push_back(value.get<double>());
-      tracked_values.push_back(record.at("expression").value(expression, 0.0));
+      tracked_values.push_back(t.expression.count(expression) ? t.expression.at(expression) : 0.0);
     }
+    ++scores.frames;
   }
-  if (scores.frames == 0) throw Error(tracked_take, "has no tracked frame to score");
+  if (scores.frames == 0) throw Error("no tracked frame to score");
   scores.vertex_median_m = percentile(errors, 0.5);
   scores.vertex_p95_m = percentile(errors, 0.95);
   scores.rotation_median_deg = percentile(rotations, 0.5);
@@ -96,6 +109,24 @@ TrackScores score_against_studio(const fs::path& tracked_take, const fs::path& c
       scores.correlation[expression] = pearson(truth_values, values.second);
   }
   return scores;
+}
+
+TrackScores score_against_studio(const fs::path& tracked_take, const fs::path& capture, const std::string& take) {
+  std::vector<TrackedFrame> tracked;
+  for (const auto& entry : fs::directory_iterator(tracked_take)) {
+    if (entry.path().extension() != ".json" || entry.path().stem().string().size() != 6) continue;
+    const auto record = read_json(entry.path());
+    if (record.at("status") != "tracked") continue;
+    TrackedFrame t;
+    t.frame = record.at("frame");
+    t.vertices = read_vertices_bin(tracked_take / record.at("mesh").get<std::string>());
+    t.head_rotation = rotation_of(record.at("head_to_world"));
+    for (const auto& [name, value] : record.at("expression").items()) t.expression[name] = value.get<double>();
+    tracked.push_back(std::move(t));
+  }
+  std::sort(tracked.begin(), tracked.end(), [](const TrackedFrame& a, const TrackedFrame& b) { return a.frame < b.frame; });
+  if (tracked.empty()) throw Error(tracked_take, "has no tracked frame to score");
+  return score_frames(tracked, capture, take);
 }
 
 }  // namespace tega::tracking

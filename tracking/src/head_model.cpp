@@ -40,6 +40,12 @@ void check_in_range(const std::vector<int>& vertices, int count, const std::file
 
 }  // namespace
 
+std::vector<int> HeadModel::fit_vertices_every(int step) const {
+  std::vector<int> every;
+  for (size_t i = 0; i < fit_vertices.size(); i += size_t(std::max(1, step))) every.push_back(fit_vertices[i]);
+  return every;
+}
+
 HeadModel load_head_model(const std::filesystem::path& directory, double metres_per_unit) {
   HeadModel model;
   model.directory = directory;

@@ -108,7 +108,7 @@ RigidTransform initial_pose(const HeadModel& model, const Vertices& neutral, con
                                               options.surface),
                               {}});
     problem.frames[0].surface.scale.robust_scale = options.surface.robust_scale;
-    problem.iterations = options.coefficients.solver_iterations;
+    problem.iterations = 3 * options.coefficients.solver_iterations;  // once per take
     problem.threads = options.threads;
     if (problem.frames[0].surface.targets.size() < 50)
       throw Error("the scan does not meet the head model near where the head should be (" +

@@ -37,17 +37,18 @@ double distance_bound(const SurfaceTermOptions& o, int it, int count) {
   return o.max_distance_m + (o.final_distance_m - o.max_distance_m) * double(it) / double(count - 1);
 }
 
-CorrectionProblem correction_problem(const HeadModel& model, const Options& options,
+CorrectionProblem correction_problem(const std::vector<int>& vertices, const Options& options,
                                      const std::vector<std::pair<int, int>>& edges, const std::vector<Camera>& cameras) {
   const CorrectionOptions& o = options.corrections;
   CorrectionProblem p;
-  p.vertices = &model.skin_vertices;
+  p.vertices = &vertices;
   p.edges = &edges;
   p.smoothness = {o.smoothness_sigma_m, o.weight, 0};
   // The magnitude and temporal priors share the coefficient priors' weight.
   p.magnitude = {o.magnitude_sigma_m, options.coefficients.weight, 0};
   p.temporal = {o.temporal_sigma_m, options.coefficients.weight, 0};
   p.cameras = &cameras;
+  p.iterations = o.solver_iterations;
   p.threads = options.threads;
   return p;
 }
@@ -96,7 +97,7 @@ SubjectIdentity fit_identity(const HeadModel& model, const std::vector<FrameObse
     p.prior_scale = {1, options.coefficients.weight, 0};
     p.cameras = &cameras;
     p.frames = frame_targets(head, distance_bound(options.surface, it, iterations), model.fit_vertices);
-    p.iterations = options.coefficients.solver_iterations;
+    p.iterations = 3 * options.coefficients.solver_iterations;  // once per subject
     p.threads = options.threads;
     fit_coefficients(p, poses, subject.coefficients);
   }
@@ -105,8 +106,8 @@ SubjectIdentity fit_identity(const HeadModel& model, const std::vector<FrameObse
   if (options.corrections.enabled) {
     const auto edges = edges_between(model.shapes.neutral.faces, model.skin_vertices);
     Vertices detail = Vertices::Zero(subject.neutral.rows(), 3);
-    for (int it = 0; it < std::max(1, options.corrections.iterations); ++it) {
-      CorrectionProblem p = correction_problem(model, options, edges, cameras);
+    for (int it = 0; it < options.corrections.iterations + 1; ++it) {
+      CorrectionProblem p = correction_problem(model.skin_vertices, options, edges, cameras);
       p.base = &subject.neutral;
       p.poses = poses;
       p.frames = frame_targets(subject.neutral + detail, options.surface.final_distance_m, model.fit_vertices);
@@ -139,7 +140,7 @@ TakeTracker::TakeTracker(const HeadModel& model, const SubjectIdentity& subject,
       cameras_(std::move(cameras)),
       options_(options),
       landmarks_(landmarks),
-      skin_edges_(edges_between(model.shapes.neutral.faces, model.skin_vertices)) {}
+      fit_edges_(edges_between(model.shapes.neutral.faces, model.fit_vertices)) {}
 
 TakeTracker::~TakeTracker() = default;
 
@@ -186,6 +187,7 @@ FrameFit TakeTracker::track(const FrameObservation& frame) {
     prior_sigma = 1 / std::sqrt(a + b);
   }
   std::vector<RigidTransform> poses = {state.head_to_world};
+  const std::vector<int> coefficient_vertices = model_.fit_vertices_every(o.surface.coefficient_vertex_step);
   for (int it = 0; it < o.icp_iterations; ++it) {
     const PosedModel now = posed_model(model_, pose_vertices(model_, subject_, state));
     // The first iteration fixes the pose on what no expression moves.
@@ -199,8 +201,9 @@ FrameFit TakeTracker::track(const FrameObservation& frame) {
     p.prior_sigma = prior_sigma;
     p.prior_scale = {1, co.weight, 0};
     p.cameras = &cameras_;
-    p.frames.push_back({surface_targets(now, pose_only ? model_.pose_vertices : model_.fit_vertices, scan,
-                                        distance_bound(o.surface, it, o.icp_iterations), o.surface),
+    const double bound = distance_bound(o.surface, it, o.icp_iterations);
+    p.frames.push_back({surface_targets(now, pose_only ? model_.pose_vertices : coefficient_vertices, scan, bound,
+                                        o.surface),
                         pose_only ? std::vector<Term<ImageTarget>>{} : image_terms});
     if (previous_) p.pose_priors.push_back(&previous_->state.head_to_world);
     p.rotation_sigma_rad = co.rotation_temporal_sigma_deg * kDegree;
@@ -218,7 +221,7 @@ FrameFit TakeTracker::track(const FrameObservation& frame) {
     const Vertices shaped = with_shapes(subject_.neutral, model_.shapes.expression_deltas, state.expression);
     for (int it = 0; it < std::max(1, o.corrections.iterations); ++it) {
       const PosedModel now = posed_model(model_, pose_vertices(model_, subject_, state));
-      CorrectionProblem p = correction_problem(model_, o, skin_edges_, cameras_);
+      CorrectionProblem p = correction_problem(model_.fit_vertices, o, fit_edges_, cameras_);
       p.base = &shaped;
       p.previous = previous_ ? &previous_->state.corrections : nullptr;
       p.poses = {state.head_to_world};

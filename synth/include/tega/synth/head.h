@@ -52,6 +52,9 @@ struct Head {
   BlendshapeModel model;
   std::vector<int32_t> eyeball_faces;  // triangles of model.neutral, ascending
   std::vector<int8_t> triangle_eye;    // per triangle: 0 skin, 1 left eyeball, 2 right eyeball
+  // Where the studio left parts of the model out: the model file's vertex
+  // index of each vertex, as [first, last] runs (empty: the same numbering).
+  std::vector<std::pair<int, int>> source_vertex_runs;
   FaceFrame frame;
   Eigen::Vector3d pivot = Eigen::Vector3d::Zero();  // head-space point placed at the world origin
   std::vector<WrinkleRegion> wrinkles;

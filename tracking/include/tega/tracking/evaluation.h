@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "tega/core/mesh.h"
+
 namespace tega::tracking {
 
 struct TrackScores {
@@ -19,7 +21,18 @@ struct TrackScores {
   std::map<std::string, double> correlation;  // per true expression that varies: Pearson r over the frames
 };
 
-// `tracked_take`: TRACKED/<take>; `capture`: the studio's capture with ground_truth/.
+// One tracked frame to score.
+struct TrackedFrame {
+  int frame = 0;
+  Vertices vertices;              // world space, the model's topology
+  Eigen::Matrix3d head_rotation;  // of head_to_world
+  std::map<std::string, double> expression;
+};
+
+TrackScores score_frames(const std::vector<TrackedFrame>& frames, const std::filesystem::path& capture,
+                         const std::string& take);
+
+// `tracked_take`: TRACKED/<take> (its tracked frames); `capture`: the studio's capture with ground_truth/.
 TrackScores score_against_studio(const std::filesystem::path& tracked_take, const std::filesystem::path& capture,
                                  const std::string& take);
 

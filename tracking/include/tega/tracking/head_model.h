@@ -23,6 +23,9 @@ struct HeadModel {
   // alone fix the head pose, so a jaw that opens does not tilt the head.
   std::vector<int> pose_vertices;
 
+  // Every n-th fit vertex.
+  std::vector<int> fit_vertices_every(int step) const;
+
   int num_vertices() const { return shapes.num_vertices(); }
 };
 

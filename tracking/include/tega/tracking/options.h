@@ -19,10 +19,14 @@ struct SurfaceTermOptions {
   double final_distance_m = 0.003;   // ... the bound shrinks to this over the ICP iterations
   double max_normal_angle_deg = 60;  // ... and so are those whose normals disagree more
   double robust_scale = 3.0;         // Cauchy loss scale, in sigmas
+  int coefficient_vertex_step = 2;   // pose and coefficients use every n-th fit vertex
 
   template <class V>
   void visit(V& v) {
     v("sigma_m", sigma_m, "Expected point-to-plane distance of a good fit, metres.");
+    v("coefficient_vertex_step", coefficient_vertex_step,
+      "Pose and coefficients are fitted to every n-th fit vertex (a few thousand pin down ~60 unknowns); the "
+      "corrections use them all.");
     v("weight", weight, "Share of the energy of the surface term.");
     v("max_distance_m", max_distance_m, "Correspondences farther than this are dropped at the first ICP iteration.");
     v("final_distance_m", final_distance_m, "... and farther than this at the last (the bound shrinks linearly).");
@@ -84,11 +88,11 @@ struct LandmarkOptions {
 struct CoefficientOptions {
   double expression_sigma = 1.0;      // prior towards 0 (the neutral face)
   double expression_temporal_sigma = 0.3;  // frame-to-frame change
-  double identity_sigma = 3.0;        // prior towards 0 (the model's mean), in the model's units
+  double identity_sigma = 1.0;        // prior towards 0 (the model's mean), in the model's units
   double rotation_temporal_sigma_deg = 3.0;
   double translation_temporal_sigma_m = 0.005;
   double weight = 0.05;               // share of the energy of these priors
-  int solver_iterations = 15;         // Levenberg-Marquardt iterations per ICP iteration
+  int solver_iterations = 5;          // Levenberg-Marquardt iterations per ICP iteration
 
   template <class V>
   void visit(V& v) {
@@ -102,15 +106,17 @@ struct CoefficientOptions {
   }
 };
 
-// Per-vertex corrections on top of the blendshapes (identity detail once,
-// then each frame's detail), held smooth by a Laplacian (membrane) term.
+// Per-vertex corrections on top of the blendshapes, held smooth by a
+// Laplacian (membrane) term: the identity's detail once, on all the skin;
+// then each frame's detail, on the fit vertices.
 struct CorrectionOptions {
   bool enabled = true;
   double smoothness_sigma_m = 0.0002;  // expected difference of neighbouring corrections
   double magnitude_sigma_m = 0.005;    // corrections are small
   double temporal_sigma_m = 0.0005;    // a frame's corrections stay near the previous frame's
   double weight = 1.0;                 // share of the energy of the smoothness term
-  int iterations = 2;                  // correspondence updates
+  int iterations = 1;                  // correspondence updates per frame (the identity's detail gets one more)
+  int solver_iterations = 3;           // Levenberg-Marquardt iterations per correspondence update
 
   template <class V>
   void visit(V& v) {
@@ -119,7 +125,9 @@ struct CorrectionOptions {
     v("magnitude_sigma_m", magnitude_sigma_m, "Expected size of a correction, metres.");
     v("temporal_sigma_m", temporal_sigma_m, "Expected change of a frame's corrections from the previous frame's, metres.");
     v("weight", weight, "Share of the energy of the smoothness term.");
-    v("iterations", iterations, "Correspondence updates while fitting the corrections.");
+    v("iterations", iterations,
+      "Correspondence updates while fitting a frame's corrections (the identity's detail gets one more).");
+    v("solver_iterations", solver_iterations, "Levenberg-Marquardt iterations per correspondence update.");
   }
 };
 

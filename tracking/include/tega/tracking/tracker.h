@@ -109,7 +109,7 @@ class TakeTracker {
   std::vector<Camera> cameras_;
   Options options_;
   const LandmarkDetector* landmarks_;
-  std::vector<std::pair<int, int>> skin_edges_;
+  std::vector<std::pair<int, int>> fit_edges_;
   std::unique_ptr<Previous> previous_;
 };
 
