@@ -1,7 +1,6 @@
 #include "tega/mvs/patch_match.h"
 
 #include <algorithm>
-#include <chrono>
 #include <memory>
 #include <optional>
 #include <utility>
@@ -9,7 +8,6 @@
 #include "patch_match_backend.h"
 #include "pyramid.h"
 #include "tega/core/error.h"
-#include "tega/core/log.h"
 #include "tega/core/progress.h"
 #include "tega/core/thread_pool.h"
 
@@ -127,10 +125,6 @@ Device parse_device(const std::string& name) {
 
 namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 struct Solver {
   const std::vector<ViewTask>& tasks;
   Device device;
@@ -160,12 +154,10 @@ struct Solver {
                                                                    const PatchMatchOptions& options,
                                                                    int levels) const {
     if (levels > 0) return refine(views, options, levels);
-    const auto start = std::chrono::steady_clock::now();
     auto run = backend(views);
     pass(*run, options, false, 0, options.iterations);
     for (int p = 0; p < options.geometric_passes; ++p)
       pass(*run, options, true, options.iterations + p * options.geometric_iterations, options.geometric_iterations);
-    logging::debug("patch match at %dx%d: %.2f s", views[0].camera.width, views[0].camera.height, seconds_since(start));
     return {std::move(run), options.iterations + options.geometric_passes * options.geometric_iterations};
   }
 
@@ -182,7 +174,6 @@ struct Solver {
     coarse.sigma_spatial = 0.5f * options.sigma_spatial;
     auto [coarse_backend, iterations] = solve(half, coarse, levels - 1);
 
-    const auto start = std::chrono::steady_clock::now();
     const detail::PatchMatchBackend& coarse_estimates = *coarse_backend;
     std::vector<DepthMap> up(tasks.size());
     pool.parallel_for(0, int64_t(tasks.size()), [&](int64_t t) {
@@ -194,11 +185,8 @@ struct Solver {
     auto run = backend(views);
     for (size_t t = 0; t < tasks.size(); ++t) run->set_estimate(tasks[t].reference, up[t]);
     up.clear();
-    const double carry_s = seconds_since(start);
     for (int p = 0; p < options.refine_passes; ++p)
       pass(*run, options, true, iterations + p * options.refine_iterations, options.refine_iterations);
-    logging::debug("patch match at %dx%d: carried up in %.2f s, refined in %.2f s", views[0].camera.width,
-                   views[0].camera.height, carry_s, seconds_since(start) - carry_s);
     return {std::move(run), iterations + options.refine_passes * options.refine_iterations};
   }
 };
