@@ -109,8 +109,8 @@ void report_mesh(const Mesh& mesh, const fs::path& root, int frame) {
 int main(int argc, char** argv) {
   CLI::App app{"Multi-view stereo time and accuracy on one virtual-studio frame."};
   int cameras = 13, width = 512, height = 384, frame = 0, threads = 0, window_radius = 0, window_step = 0,
-      fusion_step = 0, iterations = 0, geometric_iterations = 0, pyramid_levels = -1, refine_passes = 0,
-      refine_iterations = 0, poisson_depth = 0;
+      fusion_step = 0, iterations = 0, geometric_iterations = 0, pyramid_levels = -1, refine_passes = -1,
+      refine_iterations = 0, poisson_depth = 0, surface_threads = 0;
   double voxel_size = 0;
   std::string cloud_file;
   bool verbose = false;
@@ -137,6 +137,7 @@ int main(int argc, char** argv) {
   app.add_option("--config", config, "YAML whose `mvs` section sets the options.");
 #endif
   app.add_option("--poisson-depth", poisson_depth, "Poisson octree depth (default: the options'; needs Open3D).");
+  app.add_option("--surface-threads", surface_threads, "Threads of the surface stage (default: the options', else --threads).");
 #ifdef TEGA_BENCH_HAVE_SURFACE
   app.add_option("--cloud", cloud_file,
                  "Mesh and score this fused cloud of the frame (e.g. one the GPU machine made) instead of making one.");
@@ -171,11 +172,12 @@ int main(int argc, char** argv) {
   if (window_radius > 0) pm.window_radius = window_radius;
   if (window_step > 0) pm.window_step = window_step;
   if (pyramid_levels >= 0) pm.pyramid_levels = pyramid_levels;
-  if (refine_passes > 0) pm.refine_passes = refine_passes;
+  if (refine_passes >= 0) pm.refine_passes = refine_passes;
   if (refine_iterations > 0) pm.refine_iterations = refine_iterations;
   if (voxel_size > 0) fusion_options.voxel_size_m = voxel_size;
 #ifdef TEGA_BENCH_HAVE_SURFACE
   if (poisson_depth > 0) surface_options.poisson_depth = poisson_depth;
+  if (surface_threads > 0) surface_options.threads = surface_threads;
 #endif
   if (device == "cuda" && !mvs::cuda_device_available()) {
     std::fprintf(stderr, "mvs_bench: no CUDA device\n");
