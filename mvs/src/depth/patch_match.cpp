@@ -86,8 +86,8 @@ void check_input(const std::vector<StereoView>& views, const std::vector<ViewTas
                 std::to_string(options.window_step) + ") must have 3 to 7 samples a side");
   if (options.top_k < 1 || options.iterations < 1 || options.geometric_passes < 0 || options.geometric_iterations < 1)
     throw Error("patch match: top_k, iterations and geometric_iterations must be at least 1");
-  if (options.pyramid_levels < 0 || options.refine_passes < 0 || options.refine_iterations < 1)
-    throw Error("patch match: pyramid_levels and refine_passes must be at least 0, refine_iterations at least 1");
+  if (options.pyramid_levels < 0 || options.refine_passes < 1 || options.refine_iterations < 1)
+    throw Error("patch match: pyramid_levels must be at least 0, refine_passes and refine_iterations at least 1");
 }
 
 detail::Parameters parameters(const PatchMatchOptions& o, const ViewTask& task) {
@@ -182,9 +182,7 @@ struct Solver {
                                         views[task.reference], parameters(options, task));
     });
     coarse_backend.reset();
-    // Without passes at this size the carried-up planes are the result: they
-    // stay on the host.
-    auto run = options.refine_passes > 0 ? backend(views) : detail::make_cpu_backend(views, pool);
+    auto run = backend(views);
     for (size_t t = 0; t < tasks.size(); ++t) run->set_estimate(tasks[t].reference, up[t]);
     up.clear();
     for (int p = 0; p < options.refine_passes; ++p)

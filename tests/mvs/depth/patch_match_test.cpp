@@ -81,25 +81,6 @@ TEST(PatchMatch, CoarseToFineMatchesTheRenderedHead) {
   EXPECT_GT(coverage, 0.7);  // 0.77
 }
 
-// Without a sweep at full size the half-size planes are the estimate: coarser,
-// with the same coverage.
-TEST(PatchMatch, HalfSizePlanesCarriedUpMatchTheRenderedHead) {
-  const auto& frame = studio_frame();
-  PatchMatchOptions o = coarse_to_fine_options();
-  o.refine_passes = 0;
-  ThreadPool pool(2);
-  const auto maps = estimate_depth_maps(frame.views, frame.tasks, o, Device::cpu, &pool);
-  double within = 0, coverage = 0;
-  for (size_t k = 0; k < maps.size(); ++k) {
-    ASSERT_EQ(maps[k].width, frame.views[k].camera.width);
-    const auto a = agreement(maps[k], frame.true_depth[k], 0.002);
-    within += a.within / double(maps.size());
-    coverage += a.coverage / double(maps.size());
-  }
-  EXPECT_GT(within, 0.64);  // 0.68 measured
-  EXPECT_GT(coverage, 0.8);  // 0.86
-}
-
 TEST(PatchMatch, NormalsAreUnitAndFaceTheCamera) {
   const auto& maps = cpu_maps();
   const auto& view = studio_frame().views[0];

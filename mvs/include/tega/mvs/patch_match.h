@@ -36,8 +36,7 @@ struct PatchMatchOptions {
   int seed = 1;
   // Coarse to fine: the whole estimate (iterations and geometric passes) first
   // at half size per level, then at each finer level only refine_passes
-  // geometric passes of refine_iterations, starting from the coarser planes
-  // (0 passes: the coarser planes carried up are the estimate).
+  // geometric passes of refine_iterations, starting from the coarser planes.
   int pyramid_levels = 0;
   int refine_passes = 1;
   int refine_iterations = 2;
@@ -60,8 +59,7 @@ struct PatchMatchOptions {
     v("pyramid_levels", pyramid_levels,
       "Coarse to fine: estimate at 1/2^levels of the size first (window and sigma_spatial scaled along), then refine "
       "at each finer level (0: full size only).");
-    v("refine_passes", refine_passes,
-      "Geometric passes at each finer pyramid level (0: the coarser planes carried up are the estimate).");
+    v("refine_passes", refine_passes, "Geometric passes at each finer pyramid level.");
     v("refine_iterations", refine_iterations, "Iterations of each of those passes.");
   }
 };
