@@ -171,6 +171,8 @@ struct Solver {
     PatchMatchOptions coarse = options;
     coarse.window_radius = std::max(1, options.window_radius / 2);
     coarse.window_step = std::max(1, options.window_step / 2);
+    // Halving rounds down: the samples a side must stay within the window's limit (3 each side).
+    coarse.window_radius = std::min(coarse.window_radius, 3 * coarse.window_step);
     coarse.sigma_spatial = 0.5f * options.sigma_spatial;
     auto [coarse_backend, iterations] = solve(half, coarse, levels - 1);
 
