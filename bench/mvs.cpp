@@ -1,7 +1,8 @@
 // bench/mvs: one frame of a virtual-studio take through multi-view stereo,
 // each stage timed (load, depth, fusion, surface) and scored against the
 // studio's ground truth: depth maps against rendered true depth, and (where
-// tega_mvs is built) the mesh's accuracy and completeness over the face.
+// tega_mvs_surface is built, Open3D) the mesh's accuracy and completeness over
+// the face.
 // The capture is rendered once into --capture and kept for the next run.
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "tega/core/log.h"
 #include "tega/core/mesh.h"
 #include "tega/core/thread_pool.h"
 #include "tega/core/undistort.h"
@@ -19,12 +21,15 @@
 #include "tega/mvs/view_selection.h"
 #include "tega/synth/ground_truth_depth.h"
 #include "tega/synth/virtual_studio.h"
+#ifdef TEGA_BENCH_HAVE_SURFACE
+#include "tega/mvs/evaluation.h"
+#include "tega/mvs/studio_truth.h"
+#include "tega/mvs/surface.h"
+#endif
 #ifdef TEGA_BENCH_HAVE_MVS
 #include "tega/core/options.h"
-#include "tega/mvs/evaluation.h"
 #include "tega/mvs/masks.h"
 #include "tega/mvs/reconstruction.h"
-#include "tega/mvs/studio_truth.h"
 #endif
 
 namespace fs = std::filesystem;
@@ -52,15 +57,17 @@ fs::path render_capture(const fs::path& root, int cameras, int width, int height
 }
 
 // Masks from the true coverage (builds without OpenCV have no clean-plate masks).
-void mask_from_truth(std::vector<mvs::StereoView>& views, const fs::path& root, const Rig& rig, int frame) {
-  for (auto& view : views) {
+void mask_from_truth(std::vector<mvs::StereoView>& views, const fs::path& root, const Rig& rig, int frame,
+                     ThreadPool& pool) {
+  pool.parallel_for(0, int64_t(views.size()), [&](int64_t k) {
+    mvs::StereoView& view = views[size_t(k)];
     char name[32];
     std::snprintf(name, sizeof name, "%06d.png", frame);
     const Image8 alpha = read_image_u8(root / "ground_truth" / "expressions" / "alpha" / view.camera.name / name);
     const Image8 undistorted = undistort_image(alpha, rig.camera(view.camera.name));
     view.mask.resize(undistorted.pixels.size());
     for (size_t i = 0; i < view.mask.size(); ++i) view.mask[i] = undistorted.pixels[i] > 0 ? 255 : 0;
-  }
+  });
 }
 
 struct DepthScore {
@@ -83,7 +90,7 @@ void score_depth(const mvs::DepthMap& map, const ImageF& truth, DepthScore& scor
   }
 }
 
-#ifdef TEGA_BENCH_HAVE_MVS
+#ifdef TEGA_BENCH_HAVE_SURFACE
 // The mesh against the frame's true fine mesh, over the face.
 void report_mesh(const Mesh& mesh, const fs::path& root, int frame) {
   const mvs::StudioTruth truth = mvs::load_studio_truth(root, "expressions", frame);
@@ -102,8 +109,11 @@ void report_mesh(const Mesh& mesh, const fs::path& root, int frame) {
 int main(int argc, char** argv) {
   CLI::App app{"Multi-view stereo time and accuracy on one virtual-studio frame."};
   int cameras = 13, width = 512, height = 384, frame = 0, threads = 0, window_radius = 0, window_step = 0,
-      fusion_step = 0, iterations = 0, geometric_iterations = 0;
+      fusion_step = 0, iterations = 0, geometric_iterations = 0, pyramid_levels = -1, refine_passes = -1,
+      refine_iterations = 0, poisson_depth = 0, surface_threads = 0;
+  double voxel_size = 0;
   std::string cloud_file;
+  bool verbose = false;
   std::string device = "cpu", capture = (fs::temp_directory_path() / "tega-mvs-bench").string(), out, config;
   app.add_option("--cameras", cameras, "Cameras.");
   app.add_option("--width", width, "Image width.");
@@ -118,12 +128,22 @@ int main(int argc, char** argv) {
   app.add_option("--fusion-step", fusion_step, "Fuse every n-th pixel and row (default: the options').");
   app.add_option("--iterations", iterations, "Photometric PatchMatch iterations (default: the options').");
   app.add_option("--geometric-iterations", geometric_iterations, "Geometric iterations (default: the options').");
+  app.add_option("--pyramid-levels", pyramid_levels, "Coarse-to-fine levels (default: the options').");
+  app.add_option("--refine-passes", refine_passes, "Geometric passes at each finer level (default: the options').");
+  app.add_option("--refine-iterations", refine_iterations, "Iterations of those passes (default: the options').");
+  app.add_option("--voxel-size", voxel_size, "Fusion voxel size in metres (default: the options').");
+  app.add_flag("--verbose", verbose, "Log each stage's parts (debug level).");
 #ifdef TEGA_BENCH_HAVE_MVS
   app.add_option("--config", config, "YAML whose `mvs` section sets the options.");
+#endif
+  app.add_option("--poisson-depth", poisson_depth, "Poisson octree depth (default: the options'; needs Open3D).");
+  app.add_option("--surface-threads", surface_threads, "Threads of the surface stage (default: the options', else --threads).");
+#ifdef TEGA_BENCH_HAVE_SURFACE
   app.add_option("--cloud", cloud_file,
                  "Mesh and score this fused cloud of the frame (e.g. one the GPU machine made) instead of making one.");
 #endif
   CLI11_PARSE(app, argc, argv);
+  init_logging(verbose ? 2 : 1);
 
   const fs::path root = render_capture(capture + "-" + std::to_string(cameras) + "-" + std::to_string(width) + "x" +
                                            std::to_string(height),
@@ -136,29 +156,44 @@ int main(int argc, char** argv) {
   if (!config.empty()) load_options(options, config, "mvs");
   mvs::PatchMatchOptions pm = options.patch_match;
   mvs::FusionOptions fusion_options = options.fusion;
+#ifdef TEGA_BENCH_HAVE_SURFACE
+  mvs::SurfaceOptions surface_options = options.surface;
+#endif
 #else
   mvs::PatchMatchOptions pm;
   mvs::FusionOptions fusion_options;
+#ifdef TEGA_BENCH_HAVE_SURFACE
+  mvs::SurfaceOptions surface_options;
+#endif
 #endif
   if (fusion_step > 0) fusion_options.pixel_step = fusion_step;
   if (iterations > 0) pm.iterations = iterations;
   if (geometric_iterations > 0) pm.geometric_iterations = geometric_iterations;
   if (window_radius > 0) pm.window_radius = window_radius;
   if (window_step > 0) pm.window_step = window_step;
+  if (pyramid_levels >= 0) pm.pyramid_levels = pyramid_levels;
+  if (refine_passes >= 0) pm.refine_passes = refine_passes;
+  if (refine_iterations > 0) pm.refine_iterations = refine_iterations;
+  if (voxel_size > 0) fusion_options.voxel_size_m = voxel_size;
+#ifdef TEGA_BENCH_HAVE_SURFACE
+  if (poisson_depth > 0) surface_options.poisson_depth = poisson_depth;
+  if (surface_threads > 0) surface_options.threads = surface_threads;
+#endif
   if (device == "cuda" && !mvs::cuda_device_available()) {
     std::fprintf(stderr, "mvs_bench: no CUDA device\n");
     return 1;
   }
 
-#ifdef TEGA_BENCH_HAVE_MVS
+#ifdef TEGA_BENCH_HAVE_SURFACE
+  if (surface_options.threads == 0) surface_options.threads = pool.size();
   if (!cloud_file.empty()) {
     const mvs::OrientedPointCloud cloud = mvs::read_point_cloud_ply(cloud_file);
     const auto start = Clock::now();
-    const Mesh mesh = mvs::reconstruct_surface(cloud, options.surface);
+    const Mesh mesh = mvs::reconstruct_surface(cloud, surface_options);
     const double surface_s = seconds_since(start);
     report_mesh(mesh, root, frame);
-    std::printf("%s: %d points; surface %.2f s on %d threads\n", cloud_file.c_str(), cloud.size(), surface_s,
-                options.surface.threads);
+    std::printf("%s: %d points; surface (Poisson depth %d) %.2f s on %d threads\n", cloud_file.c_str(), cloud.size(),
+                surface_options.poisson_depth, surface_s, surface_options.threads);
     return 0;
   }
 #endif
@@ -167,10 +202,12 @@ int main(int argc, char** argv) {
 #ifdef TEGA_BENCH_HAVE_MVS
   const mvs::FrameLoader plate_loader(read_take(root / "takes" / "clean_plate"), rig, (root / "rig.json").string());
   const auto plates = plate_loader.load(0, pool);
-  for (size_t k = 0; k < views.size(); ++k) views[k].mask = mvs::subject_mask(views[k].colour, plates[k].colour, options.mask);
+  pool.parallel_for(0, int64_t(views.size()), [&](int64_t k) {
+    views[size_t(k)].mask = mvs::subject_mask(views[size_t(k)].colour, plates[size_t(k)].colour, options.mask);
+  });
   const char* mask_source = "clean plate";
 #else
-  mask_from_truth(views, root, rig, frame);
+  mask_from_truth(views, root, rig, frame, pool);
   const char* mask_source = "true coverage";
 #endif
   const double load_s = seconds_since(start);
@@ -214,9 +251,9 @@ int main(int argc, char** argv) {
   std::printf("fused cloud: %d points\n", cloud.size());
 
   double surface_s = 0;
-#ifdef TEGA_BENCH_HAVE_MVS
+#ifdef TEGA_BENCH_HAVE_SURFACE
   start = Clock::now();
-  const Mesh mesh = mvs::reconstruct_surface(cloud, options.surface);
+  const Mesh mesh = mvs::reconstruct_surface(cloud, surface_options);
   surface_s = seconds_since(start);
   report_mesh(mesh, root, frame);
   if (!out.empty()) {

@@ -226,10 +226,11 @@ void reconstruct_frames(const TakeJob& job, const Options& options, MvsSummary& 
     try {
       auto start = Clock::now();
       std::vector<StereoView> views = job.loader.load(frame, pool);
-      for (auto& view : views) {
+      pool.parallel_for(0, int64_t(views.size()), [&](int64_t k) {
+        StereoView& view = views[size_t(k)];
         const auto plate = job.plates.find(view.camera.name);
         if (plate != job.plates.end()) view.mask = subject_mask(view.colour, plate->second, options.mask);
-      }
+      });
       const double load_s = seconds_since(start);
       FrameReconstruction r = reconstruct_views(views, options, summary.device, label, pool);
       r.timings.load_s = load_s;

@@ -1,9 +1,12 @@
 #include "tega/mvs/patch_match.h"
 
 #include <algorithm>
+#include <memory>
 #include <optional>
+#include <utility>
 
 #include "patch_match_backend.h"
+#include "pyramid.h"
 #include "tega/core/error.h"
 #include "tega/core/progress.h"
 #include "tega/core/thread_pool.h"
@@ -83,6 +86,8 @@ void check_input(const std::vector<StereoView>& views, const std::vector<ViewTas
                 std::to_string(options.window_step) + ") must have 3 to 7 samples a side");
   if (options.top_k < 1 || options.iterations < 1 || options.geometric_passes < 0 || options.geometric_iterations < 1)
     throw Error("patch match: top_k, iterations and geometric_iterations must be at least 1");
+  if (options.pyramid_levels < 0 || options.refine_passes < 1 || options.refine_iterations < 1)
+    throw Error("patch match: pyramid_levels must be at least 0, refine_passes and refine_iterations at least 1");
 }
 
 detail::Parameters parameters(const PatchMatchOptions& o, const ViewTask& task) {
@@ -118,37 +123,88 @@ Device parse_device(const std::string& name) {
   throw Error("unknown device '" + name + "' (expected cpu or cuda)");
 }
 
+namespace {
+
+struct Solver {
+  const std::vector<ViewTask>& tasks;
+  Device device;
+  ThreadPool& pool;
+  Progress* progress;
+
+  std::unique_ptr<detail::PatchMatchBackend> backend(const std::vector<StereoView>& views) const {
+    return device == Device::cuda ? detail::make_cuda_backend(views) : detail::make_cpu_backend(views, pool);
+  }
+
+  // One pass over every task: photometric from random hypotheses, or
+  // geometric against the sources' current estimates.
+  void pass(detail::PatchMatchBackend& backend, const PatchMatchOptions& options, bool geometric,
+            int first_iteration, int iterations) const {
+    for (const auto& task : tasks) {
+      detail::Parameters p = parameters(options, task);
+      p.geometric = geometric;
+      backend.run(task, p, first_iteration, iterations);
+      if (progress) progress->advance();
+    }
+    backend.finish_pass();
+  }
+
+  // The backend holding every task's estimate (before the cost limit), and
+  // the iterations run.
+  std::pair<std::unique_ptr<detail::PatchMatchBackend>, int> solve(const std::vector<StereoView>& views,
+                                                                   const PatchMatchOptions& options,
+                                                                   int levels) const {
+    if (levels > 0) return refine(views, options, levels);
+    auto run = backend(views);
+    pass(*run, options, false, 0, options.iterations);
+    for (int p = 0; p < options.geometric_passes; ++p)
+      pass(*run, options, true, options.iterations + p * options.geometric_iterations, options.geometric_iterations);
+    return {std::move(run), options.iterations + options.geometric_passes * options.geometric_iterations};
+  }
+
+  // The estimate at half size, its planes carried up, then geometric passes
+  // at this size. The window covers the same part of the scene at both sizes.
+  std::pair<std::unique_ptr<detail::PatchMatchBackend>, int> refine(const std::vector<StereoView>& views,
+                                                                    const PatchMatchOptions& options,
+                                                                    int levels) const {
+    std::vector<StereoView> half(views.size());
+    pool.parallel_for(0, int64_t(views.size()), [&](int64_t k) { half[size_t(k)] = detail::half_size(views[size_t(k)]); });
+    PatchMatchOptions coarse = options;
+    coarse.window_radius = std::max(1, options.window_radius / 2);
+    coarse.window_step = std::max(1, options.window_step / 2);
+    // Halving rounds down: the samples a side must stay within the window's limit (3 each side).
+    coarse.window_radius = std::min(coarse.window_radius, 3 * coarse.window_step);
+    coarse.sigma_spatial = 0.5f * options.sigma_spatial;
+    auto [coarse_backend, iterations] = solve(half, coarse, levels - 1);
+
+    const detail::PatchMatchBackend& coarse_estimates = *coarse_backend;
+    std::vector<DepthMap> up(tasks.size());
+    pool.parallel_for(0, int64_t(tasks.size()), [&](int64_t t) {
+      const ViewTask& task = tasks[size_t(t)];
+      up[size_t(t)] = detail::upsampled(coarse_estimates.estimate(task.reference), half[task.reference].camera,
+                                        views[task.reference], parameters(options, task));
+    });
+    coarse_backend.reset();
+    auto run = backend(views);
+    for (size_t t = 0; t < tasks.size(); ++t) run->set_estimate(tasks[t].reference, up[t]);
+    up.clear();
+    for (int p = 0; p < options.refine_passes; ++p)
+      pass(*run, options, true, iterations + p * options.refine_iterations, options.refine_iterations);
+    return {std::move(run), iterations + options.refine_passes * options.refine_iterations};
+  }
+};
+
+}  // namespace
+
 std::vector<DepthMap> estimate_depth_maps(const std::vector<StereoView>& views, const std::vector<ViewTask>& tasks,
                                           const PatchMatchOptions& options, Device device, ThreadPool* pool,
                                           Progress* progress) {
   check_input(views, tasks, options);
   std::optional<ThreadPool> own_pool;
-  if (!pool && device == Device::cpu) pool = &own_pool.emplace(0);
-  auto backend = device == Device::cuda ? detail::make_cuda_backend(views) : detail::make_cpu_backend(views, *pool);
-
-  // By view, so that a geometric pass finds every source's last estimate.
-  std::vector<DepthMap> by_view(views.size());
-  for (const auto& task : tasks) {
-    by_view[task.reference] = backend->run(task, parameters(options, task), {}, 0, options.iterations);
-    if (progress) progress->advance();
-  }
-  for (int pass = 0; pass < options.geometric_passes; ++pass) {
-    std::vector<DepthMap> next(views.size());
-    for (const auto& task : tasks) {
-      detail::Parameters p = parameters(options, task);
-      p.geometric = true;
-      next[task.reference] = backend->run(task, p, by_view, options.iterations + pass * options.geometric_iterations,
-                                          options.geometric_iterations);
-      if (progress) progress->advance();
-    }
-    by_view = std::move(next);
-  }
-  std::vector<DepthMap> maps;
-  maps.reserve(tasks.size());
-  for (const auto& task : tasks) {
-    maps.push_back(std::move(by_view[task.reference]));
-    drop_costly(maps.back(), options.max_cost);
-  }
+  if (!pool) pool = &own_pool.emplace(0);
+  const auto estimates = Solver{tasks, device, *pool, progress}.solve(views, options, options.pyramid_levels).first;
+  std::vector<DepthMap> maps(tasks.size());
+  for (size_t t = 0; t < tasks.size(); ++t) maps[t] = estimates->estimate(tasks[t].reference);
+  pool->parallel_for(0, int64_t(maps.size()), [&](int64_t t) { drop_costly(maps[size_t(t)], options.max_cost); });
   return maps;
 }
 

@@ -15,15 +15,20 @@ namespace tega::mvs::detail {
 ReferenceView reference_geometry(const Camera& camera);
 SourceView source_geometry(const Camera& reference, const Camera& source);
 
+// Holds every view's estimate where the sweeps run (on the GPU for the CUDA
+// path), so that passes hand maps on without copies: a pass writes the next
+// estimates while reading the current ones, and finish_pass() makes them current.
 class PatchMatchBackend {
  public:
   virtual ~PatchMatchBackend() = default;
-  // One view's estimate. Photometric passes start from random hypotheses;
-  // geometric ones (params.geometric) start from previous[task.reference] and
-  // read the sources' depth in `previous` (indexed by view). Every sweep runs
+  // The next estimate of the task's reference view. Photometric runs start
+  // from random hypotheses; geometric ones (params.geometric) from the view's
+  // current estimate, and read the sources' current depth. Every sweep runs
   // `sweeps` times from `first_iteration` on (params.iteration counts on).
-  virtual DepthMap run(const ViewTask& task, Parameters params, const std::vector<DepthMap>& previous,
-                       int first_iteration, int sweeps) = 0;
+  virtual void run(const ViewTask& task, Parameters params, int first_iteration, int sweeps) = 0;
+  virtual void finish_pass() = 0;
+  virtual void set_estimate(int view, const DepthMap& map) = 0;  // the view's current estimate
+  virtual DepthMap estimate(int view) const = 0;                 // empty where the view has none
 };
 
 std::unique_ptr<PatchMatchBackend> make_cpu_backend(const std::vector<StereoView>& views, ThreadPool& pool);

@@ -12,10 +12,18 @@ GreyImage grey_image(const StereoView& view) {
 
 class CpuBackend final : public PatchMatchBackend {
  public:
-  CpuBackend(const std::vector<StereoView>& views, ThreadPool& pool) : views_(views), pool_(pool) {}
+  CpuBackend(const std::vector<StereoView>& views, ThreadPool& pool)
+      : views_(views), pool_(pool), current_(views.size()), next_(views.size()) {}
 
-  DepthMap run(const ViewTask& task, Parameters params, const std::vector<DepthMap>& previous, int first_iteration,
-               int sweeps) override {
+  void finish_pass() override {
+    for (size_t v = 0; v < next_.size(); ++v)
+      if (!next_[v].depth.empty()) current_[v] = std::move(next_[v]);
+    next_.assign(views_.size(), {});
+  }
+  void set_estimate(int view, const DepthMap& map) override { current_[size_t(view)] = map; }
+  DepthMap estimate(int view) const override { return current_[size_t(view)]; }
+
+  void run(const ViewTask& task, Parameters params, int first_iteration, int sweeps) override {
     const StereoView& view = views_[task.reference];
     ReferenceView ref = reference_geometry(view.camera);
     ref.image = grey_image(view);
@@ -25,11 +33,12 @@ class CpuBackend final : public PatchMatchBackend {
       SourceView source = source_geometry(view.camera, views_[s].camera);
       source.image = grey_image(views_[s]);
       // A source without an estimate adds the same penalty to every hypothesis.
-      if (params.geometric && !previous[s].depth.empty()) source.depth = previous[s].depth.data();
+      if (params.geometric && !current_[s].depth.empty()) source.depth = current_[s].depth.data();
       sources.push_back(source);
     }
     const int width = ref.image.width, height = ref.image.height;
-    DepthMap map = params.geometric ? previous[task.reference] : DepthMap(width, height);
+    DepthMap& map = next_[task.reference];
+    map = params.geometric ? current_[task.reference] : DepthMap(width, height);
     const PixelStates states{map.depth.data(), map.normals.data(), map.cost.data()};
 
     if (!params.geometric) {
@@ -46,12 +55,12 @@ class CpuBackend final : public PatchMatchBackend {
         });
       }
     }
-    return map;
   }
 
  private:
   const std::vector<StereoView>& views_;
   ThreadPool& pool_;
+  std::vector<DepthMap> current_, next_;  // by view
 };
 
 }  // namespace

@@ -34,6 +34,12 @@ struct PatchMatchOptions {
   float geometric_max_error_px = 3.0f;  // the reprojection error is clipped here
   float max_cost = 0.7f;        // estimates costing more are dropped
   int seed = 1;
+  // Coarse to fine: the whole estimate (iterations and geometric passes) first
+  // at half size per level, then at each finer level only refine_passes
+  // geometric passes of refine_iterations, starting from the coarser planes.
+  int pyramid_levels = 0;
+  int refine_passes = 1;
+  int refine_iterations = 2;
 
   template <class V>
   void visit(V& v) {
@@ -50,6 +56,11 @@ struct PatchMatchOptions {
     v("geometric_max_error_px", geometric_max_error_px, "The reprojection error is clipped at this many pixels.");
     v("max_cost", max_cost, "Estimates whose final cost exceeds this are dropped.");
     v("seed", seed, "Seed of the random hypotheses (the result is deterministic for a seed).");
+    v("pyramid_levels", pyramid_levels,
+      "Coarse to fine: estimate at 1/2^levels of the size first (window and sigma_spatial scaled along), then refine "
+      "at each finer level (0: full size only).");
+    v("refine_passes", refine_passes, "Geometric passes at each finer pyramid level.");
+    v("refine_iterations", refine_iterations, "Iterations of each of those passes.");
   }
 };
 
@@ -74,7 +85,7 @@ bool cuda_device_available();                  // a CUDA build with a usable GPU
 
 // Depth maps of every task's reference view, in task order. `pool` runs the
 // CPU path (nullptr: a pool of its own); `progress`, when given, advances by
-// one per view and pass. Throws tega::Error on bad input (sizes, indices) and
+// one per view and pass (at every pyramid level). Throws tega::Error on bad input (sizes, indices) and
 // when the device is not available.
 std::vector<DepthMap> estimate_depth_maps(const std::vector<StereoView>& views, const std::vector<ViewTask>& tasks,
                                           const PatchMatchOptions& options, Device device, ThreadPool* pool = nullptr,
