@@ -9,7 +9,7 @@
 #include "surface_sampling.h"
 #include "tega/core/error.h"
 #include "tega/core/thread_pool.h"
-#include "triangle_distance_tree.h"
+#include "tega/core/triangle_distance_tree.h"
 
 namespace tega::mvs {
 namespace {

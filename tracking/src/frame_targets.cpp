@@ -108,7 +108,7 @@ Term<ImageTarget> landmark_targets(const HeadModel& model, const PosedModel& pos
     const Eigen::Vector2d grow = kLandmarkBoxGrowth * box.sizes();
     box = FaceBox(box.min() - grow, box.max() + grow);
     if (!box.intersects(FaceBox(Eigen::Vector2d::Zero(), Eigen::Vector2d(image.width, image.height)))) return;
-    const auto found = detector.detect(image, box);
+    const auto found = detector.detect(image, options.detector_boxes ? std::nullopt : std::optional<FaceBox>(box));
     if (!found) return;
     const std::vector<int> inner(model.landmark_vertices.begin() + kFirstInnerLandmark, model.landmark_vertices.end());
     const std::vector<bool> visible = visible_from(camera.center(), posed, inner, scan);

@@ -1,5 +1,7 @@
 #include "surface_query.h"
 
+#include "tega/core/thread_pool.h"
+
 #include <open3d/core/Tensor.h>
 #include <open3d/t/geometry/RaycastingScene.h>
 
@@ -11,7 +13,13 @@ struct SurfaceQuery::Scene {
   open3d::t::geometry::RaycastingScene scene;
 };
 
-SurfaceQuery::SurfaceQuery(const Mesh& surface) : scene_(std::make_unique<Scene>()) {
+SurfaceQuery::SurfaceQuery(const Mesh& surface)
+    : scene_(std::make_unique<Scene>()), tree_(surface), face_normals_(surface.num_faces(), 3) {
+  for (int f = 0; f < surface.num_faces(); ++f) {
+    const Eigen::Vector3f a = surface.positions.row(surface.faces(f, 0)), b = surface.positions.row(surface.faces(f, 1)),
+                          c = surface.positions.row(surface.faces(f, 2));
+    face_normals_.row(f) = (b - a).cross(c - a).normalized().transpose();
+  }
   const int64_t n = surface.num_vertices(), m = surface.num_faces();
   std::vector<float> positions(surface.positions.data(), surface.positions.data() + 3 * n);
   std::vector<uint32_t> faces(3 * m);
@@ -24,21 +32,13 @@ SurfaceQuery::SurfaceQuery(const Mesh& surface) : scene_(std::make_unique<Scene>
 SurfaceQuery::~SurfaceQuery() = default;
 
 std::vector<ClosestPoint> SurfaceQuery::closest(const std::vector<Eigen::Vector3d>& points) const {
-  const int64_t n = static_cast<int64_t>(points.size());
-  if (n == 0) return {};
-  std::vector<float> query(3 * n);
-  for (int64_t i = 0; i < n; ++i)
-    for (int k = 0; k < 3; ++k) query[3 * i + k] = static_cast<float>(points[i][k]);
-  auto result = scene_->scene.ComputeClosestPoints(o3c::Tensor(query, {n, 3}, o3c::Float32));
-  const o3c::Tensor found = result.at("points").Contiguous();
-  const o3c::Tensor normals = result.at("primitive_normals").Contiguous();
-  const float* p = found.GetDataPtr<float>();
-  const float* q = normals.GetDataPtr<float>();
   std::vector<ClosestPoint> out(points.size());
-  for (int64_t i = 0; i < n; ++i) {
-    out[i].point = Eigen::Vector3d(p[3 * i], p[3 * i + 1], p[3 * i + 2]);
-    out[i].normal = Eigen::Vector3d(q[3 * i], q[3 * i + 1], q[3 * i + 2]).normalized();
-  }
+  ThreadPool pool(0);
+  pool.parallel_for(0, int64_t(points.size()), [&](int64_t i) {
+    const auto found = tree_.closest(points[size_t(i)]);
+    out[size_t(i)].point = found.point;
+    out[size_t(i)].normal = face_normals_.row(std::max(0, found.face)).cast<double>().transpose();
+  });
   return out;
 }
 

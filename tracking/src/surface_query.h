@@ -1,14 +1,16 @@
 #pragma once
 // Questions to a scanned surface (a frame's multi-view stereo mesh), asked
-// in batches through Open3D's ray-casting scene (Embree): the closest
-// surface point to each query point, and whether the straight line from a
-// camera to a point is blocked.
+// in batches: the closest surface point to each query point (core's exact
+// triangle tree; Debian's Open3D 0.16 aborts on an assertion in its
+// closest-point query for some Poisson meshes), and whether the straight
+// line from a camera to a point is blocked (Open3D's ray casting, Embree).
 
 #include <Eigen/Core>
 #include <memory>
 #include <vector>
 
 #include "tega/core/mesh.h"
+#include "tega/core/triangle_distance_tree.h"
 
 namespace tega::tracking {
 
@@ -33,6 +35,8 @@ class SurfaceQuery {
  private:
   struct Scene;
   std::unique_ptr<Scene> scene_;
+  TriangleDistanceTree tree_;
+  Vertices face_normals_;
 };
 
 }  // namespace tega::tracking

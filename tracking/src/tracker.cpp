@@ -274,6 +274,8 @@ void TakeTracker::resume_from(const HeadState& state) {
   previous_->posed = posed_model(model_, pose_vertices(model_, subject_, state));
 }
 
+void TakeTracker::forget() { previous_.reset(); }
+
 void TakeTracker::break_sequence() {
   if (!previous_) return;
   previous_->scan.reset();

@@ -112,9 +112,17 @@ void track_take(const TakeContext& t, const Options& options, TrackSummary& summ
     if (needs_photos(options, t.landmarks)) observation.images = frame_photos(t.take, frame, pool);
     if (!follows) tracker.break_sequence();
     FrameFit fit = tracker.track(observation);
+    auto reason = tracker.rejection(fit);
+    // Too far from the frame it started from (after a gap, or a fast move):
+    // start afresh before giving up.
+    if (reason && tracker.has_previous()) {
+      tracker.forget();
+      fit = tracker.track(observation);
+      reason = tracker.rejection(fit);
+    }
     record.state = fit.state;
     record.residuals = fit.residuals;
-    if (auto reason = tracker.rejection(fit)) {
+    if (reason) {
       record.status = "failed";
       record.reason = *reason;
       logging::warn("track: take %s, frame %d failed: %s", t.take.name.c_str(), frame, reason->c_str());

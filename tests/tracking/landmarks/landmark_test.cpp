@@ -22,6 +22,7 @@
 #include "tega/core/mesh.h"
 #include "tega/core/rig.h"
 #include "tega/synth/virtual_studio.h"
+#include "tega/tracking/evaluation.h"
 #include "tega/tracking/landmarks.h"
 #include "test_support.h"
 
@@ -60,7 +61,6 @@ synth::Options studio_options(const fs::path& ict) {
 struct Capture {
   fs::path root;
   Rig rig;
-  Mesh template_mesh;
   std::vector<int> landmark_vertices;
 };
 
@@ -73,7 +73,6 @@ const Capture& studio_capture(const fs::path& ict) {
     Capture c;
     c.root = dir / "capture";
     c.rig = read_rig_json(c.root / "rig.json");
-    c.template_mesh = read_obj(c.root / "ground_truth/head/template.obj");
     const auto indices = nlohmann::json::parse(read_text_file(ict / "vertex_indices.json"));
     c.landmark_vertices = indices.at("idx_to_landmark_verts").get<std::vector<int>>();
     return c;
@@ -87,30 +86,10 @@ std::string frame_name(int frame) {
   return name;
 }
 
-// The true landmarks of one image: the true mesh's landmark vertices through
-// the camera's lens. Those on the far side of the head (normal facing away)
-// are unknown (NaN): no image shows where they are. The box is the bounding
-// box of all 68 grown by 15 %, the same whatever is hidden.
+// The true landmarks of one image (tracking's studio_landmark_sample).
 LandmarkSample true_sample(const Capture& capture, const std::string& take, const std::string& camera_name,
                            int frame) {
-  Mesh mesh = capture.template_mesh;
-  mesh.positions = read_vertices_bin(capture.root / "ground_truth" / take / "coarse" / (frame_name(frame) + ".bin"),
-                                     mesh.num_vertices());
-  const Vertices normals = mesh.vertex_normals();
-  const Camera& camera = capture.rig.camera(camera_name);
-  LandmarkSample sample;
-  sample.image = read_image_u8(capture.root / "takes" / take / camera_name / (frame_name(frame) + ".png"));
-  for (const int vertex : capture.landmark_vertices) {
-    const Eigen::Vector3d position = mesh.positions.row(vertex).cast<double>();
-    const Eigen::Vector3d normal = normals.row(vertex).cast<double>();
-    const Eigen::Vector2d pixel = camera.project(position).value();
-    sample.box.extend(pixel);
-    const bool facing = normal.dot(camera.center() - position) > 0;
-    sample.landmarks.push_back(facing ? pixel : Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN()));
-  }
-  const Eigen::Vector2d margin = 0.075 * sample.box.sizes();
-  sample.box = FaceBox(sample.box.min() - margin, sample.box.max() + margin);
-  return sample;
+  return studio_landmark_sample(capture.root, take, camera_name, frame, capture.landmark_vertices);
 }
 
 double median(std::vector<double> values) {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "tega/core/mesh.h"
+#include "tega/tracking/landmarks.h"
 
 namespace tega::tracking {
 
@@ -20,6 +21,17 @@ struct TrackScores {
   double rotation_median_deg = 0, rotation_max_deg = 0;
   std::map<std::string, double> correlation;  // per true expression that varies: Pearson r over the frames
 };
+
+// The model's vertex index of each vertex of the studio's template
+// (head.json's source_vertex_runs; the same numbering where it has none).
+std::vector<int> studio_model_vertices(const std::filesystem::path& capture);
+
+// A training sample for a landmark predictor from a studio photo: the true
+// mesh's landmark vertices (`landmark_vertices`, the model's numbering)
+// projected through the rig's lens; those on the far side of the head
+// (normal facing away) are NaN. The box: all 68 grown by 15 %.
+LandmarkSample studio_landmark_sample(const std::filesystem::path& capture, const std::string& take,
+                                      const std::string& camera, int frame, const std::vector<int>& landmark_vertices);
 
 // One tracked frame to score.
 struct TrackedFrame {

@@ -53,15 +53,17 @@ struct ImageTermOptions {
 // Multi-view optical flow between consecutive frames (OpenCV's DIS),
 // back-projected through the rig, so that the surface does not slide.
 struct FlowOptions {
-  bool enabled = true;
-  ImageTermOptions term{1.0, 0.5, 3.0};
+  bool enabled = false;  // see docs/tracking.md: no gain on the studio's takes, 2-4x the time
+  ImageTermOptions term{1.0, 0.3, 3.0};
   double max_forward_backward_px = 1.0;  // flow whose round trip misses by more is not trusted
-  int vertex_step = 3;                   // every n-th fit vertex carries a flow target
+  int vertex_step = 8;                   // every n-th fit vertex carries a flow target
   double max_image_side = 1024;          // images are downsampled to this before the flow
 
   template <class V>
   void visit(V& v) {
-    v("enabled", enabled, "Use optical flow between consecutive frames (needs the take's images).");
+    v("enabled", enabled,
+      "Use optical flow between consecutive frames (needs the take's images; off by default: docs/tracking.md "
+      "gives the measurements).");
     v("term", term, "Weight and noise of the flow targets.");
     v("max_forward_backward_px", max_forward_backward_px,
       "Flow whose forward-backward round trip misses by more than this (pixels) is not used.");
@@ -75,12 +77,16 @@ struct LandmarkOptions {
   std::string model;  // shape_predictor_68_face_landmarks.dat or one's own; empty = no landmarks
   ImageTermOptions term{2.0, 0.3, 3.0};
   int min_views = 2;  // landmarks seen in fewer views are not used for the first pose
+  bool detector_boxes = false;  // dlib's face detector's boxes instead of the projected model's
 
   template <class V>
   void visit(V& v) {
     v("model", model, "A dlib 68-point shape predictor file (.dat); empty = track without landmarks.");
     v("term", term, "Weight and noise of the detected landmarks.");
     v("min_views", min_views, "Views a landmark needs to be triangulated for the first frame's pose.");
+    v("detector_boxes", detector_boxes,
+      "Find faces with dlib's frontal face detector (the boxes dlib's own predictor was trained on) instead of "
+      "around the projected model's landmarks (the boxes train_landmark_predictor uses).");
   }
 };
 

@@ -101,6 +101,10 @@ class TakeTracker {
   void resume_from(const HeadState& state);
   // The next frame does not follow the last accepted one (a gap): no flow.
   void break_sequence();
+  // Whether the next frame starts from an earlier one; forget() makes it
+  // start afresh, from initial_pose() and a neutral face.
+  bool has_previous() const { return previous_ != nullptr; }
+  void forget();
 
  private:
   struct Previous;

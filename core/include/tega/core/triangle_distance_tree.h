@@ -1,14 +1,15 @@
 #pragma once
-// Exact distance from points to a triangle mesh: a bounding-volume hierarchy
-// over the triangles, searched nearest box first and pruned by the best
-// distance found so far, so the answer is the exact point-to-triangle minimum.
+// Exact closest points on a triangle mesh: a bounding-volume hierarchy over
+// the triangles, searched nearest box first and pruned by the best distance
+// found so far, so the answer is the exact point-to-triangle minimum. Used to
+// score surfaces (mvs/) and to find the scan under a model (tracking/).
 
 #include <Eigen/Core>
 #include <vector>
 
 #include "tega/core/mesh.h"
 
-namespace tega::mvs {
+namespace tega {
 
 class TriangleDistanceTree {
  public:
@@ -18,9 +19,17 @@ class TriangleDistanceTree {
   // Infinity when the tree is empty.
   double distance(const Eigen::Vector3d& point) const;
 
+  struct Closest {
+    Eigen::Vector3d point;
+    int face = -1;  // of the mesh; -1 when the tree is empty
+    double distance = 0;
+  };
+  Closest closest(const Eigen::Vector3d& point) const;
+
  private:
   struct Triangle {
     Eigen::Vector3d a, b, c;
+    int face = 0;
   };
   struct Node {
     Eigen::Vector3d lower, upper;
@@ -28,7 +37,7 @@ class TriangleDistanceTree {
     int left = -1, right = -1;
   };
   int build(int first, int count);
-  void search(int node, const Eigen::Vector3d& point, double& best_squared) const;
+  void search(int node, const Eigen::Vector3d& point, double& best_squared, Closest& best) const;
 
   std::vector<Triangle> triangles_;
   std::vector<Node> nodes_;
@@ -38,4 +47,4 @@ class TriangleDistanceTree {
 Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                           const Eigen::Vector3d& c);
 
-}  // namespace tega::mvs
+}  // namespace tega

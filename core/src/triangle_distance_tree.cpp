@@ -1,11 +1,11 @@
-#include "triangle_distance_tree.h"
+#include "tega/core/triangle_distance_tree.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numeric>
 
-namespace tega::mvs {
+namespace tega {
 namespace {
 
 constexpr int kLeafTriangles = 4;
@@ -47,7 +47,7 @@ TriangleDistanceTree::TriangleDistanceTree(const Mesh& mesh, const std::vector<i
   triangles_.reserve(chosen.size());
   for (const int f : chosen) {
     const auto vertex = [&](int k) { return mesh.positions.row(mesh.faces(f, k)).transpose().cast<double>().eval(); };
-    triangles_.push_back({vertex(0), vertex(1), vertex(2)});
+    triangles_.push_back({vertex(0), vertex(1), vertex(2), f});
   }
   if (!triangles_.empty()) build(0, int(triangles_.size()));
 }
@@ -82,12 +82,18 @@ int TriangleDistanceTree::build(int first, int count) {
   return index;
 }
 
-void TriangleDistanceTree::search(int index, const Eigen::Vector3d& point, double& best_squared) const {
+void TriangleDistanceTree::search(int index, const Eigen::Vector3d& point, double& best_squared, Closest& best) const {
   const Node& node = nodes_[size_t(index)];
   if (node.left < 0) {
     for (int i = node.first; i < node.first + node.count; ++i) {
       const Triangle& t = triangles_[size_t(i)];
-      best_squared = std::min(best_squared, (closest_point_on_triangle(point, t.a, t.b, t.c) - point).squaredNorm());
+      const Eigen::Vector3d on = closest_point_on_triangle(point, t.a, t.b, t.c);
+      const double squared = (on - point).squaredNorm();
+      if (squared < best_squared) {
+        best_squared = squared;
+        best.point = on;
+        best.face = t.face;
+      }
     }
     return;
   }
@@ -98,14 +104,18 @@ void TriangleDistanceTree::search(int index, const Eigen::Vector3d& point, doubl
     std::swap(near, far);
     std::swap(near_squared, far_squared);
   }
-  if (near_squared < best_squared) search(near, point, best_squared);
-  if (far_squared < best_squared) search(far, point, best_squared);
+  if (near_squared < best_squared) search(near, point, best_squared, best);
+  if (far_squared < best_squared) search(far, point, best_squared, best);
 }
 
-double TriangleDistanceTree::distance(const Eigen::Vector3d& point) const {
+TriangleDistanceTree::Closest TriangleDistanceTree::closest(const Eigen::Vector3d& point) const {
   double best_squared = std::numeric_limits<double>::infinity();
-  if (!nodes_.empty()) search(0, point, best_squared);
-  return std::sqrt(best_squared);
+  Closest best;
+  if (!nodes_.empty()) search(0, point, best_squared, best);
+  best.distance = std::sqrt(best_squared);
+  return best;
 }
 
-}  // namespace tega::mvs
+double TriangleDistanceTree::distance(const Eigen::Vector3d& point) const { return closest(point).distance; }
+
+}  // namespace tega
