@@ -175,6 +175,21 @@ void validate_take(const TakeInfo& t) {
   }
 }
 
+std::filesystem::path CaptureInfo::rig_file(const std::filesystem::path& chosen) const {
+  if (!chosen.empty()) return chosen;
+  return root / (rig.empty() ? std::string("rig.json") : rig);
+}
+
+std::vector<std::string> CaptureInfo::performance_takes(const std::vector<std::string>& chosen,
+                                                        const std::string& purpose) const {
+  std::vector<std::string> names = chosen;
+  if (names.empty())
+    for (const auto& take : takes)
+      if (take.kind == "performance") names.push_back(take.name);
+  if (names.empty()) throw Error(root / "capture.json", "lists no performance take " + purpose);
+  return names;
+}
+
 CaptureInfo read_capture(const fs::path& capture_root) {
   const fs::path file = capture_root / kCaptureFile;
   if (!fs::exists(file)) throw Error(capture_root, "is not a tega capture (no capture.json)");

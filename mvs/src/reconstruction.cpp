@@ -259,15 +259,9 @@ void reconstruct_frames(const TakeJob& job, const Options& options, MvsSummary& 
 
 MvsSummary reconstruct_capture(const MvsRequest& request, const Options& options) {
   const CaptureInfo capture = read_capture(request.capture);
-  const fs::path rig_file = !request.rig.empty() ? request.rig
-                            : !capture.rig.empty() ? capture.root / capture.rig
-                                                   : capture.root / "rig.json";
+  const fs::path rig_file = capture.rig_file(request.rig);
   const Rig rig = read_rig_json(rig_file);
-  std::vector<std::string> takes = request.takes;
-  if (takes.empty())
-    for (const auto& take : capture.takes)
-      if (take.kind == "performance") takes.push_back(take.name);
-  if (takes.empty()) throw Error(request.capture / "capture.json", "lists no performance take to mesh");
+  const std::vector<std::string> takes = capture.performance_takes(request.takes, "to mesh");
 
   MvsSummary summary;
   summary.device = resolve_device(options.device);

@@ -87,17 +87,33 @@ Options scan_only_options() {
   return o;
 }
 
+// The model, the subject at rest and its identity fitted to that scan.
+struct Subject {
+  HeadModel model;
+  Vertices neutral;
+  std::vector<Camera> cameras = synth::make_studio_rig({}).cameras;
+  Options options = scan_only_options();
+  TruthFrame rest;
+  Mesh rest_scan;
+  SubjectIdentity fitted;
+
+  explicit Subject(const fs::path& dir) : model(load_head_model(dir, 0.01)), neutral(subject_neutral(model)) {
+    rest = truth_frame(model, neutral, 0, {});
+    rest_scan = scan_of(model, rest.world);
+    fitted = fit_identity(model, {{&rest_scan, {}}}, cameras, options, nullptr);
+  }
+};
+
 TEST(Tracker, FitsIdentityPoseAndExpressionToScansOfTheModel) {
   const auto dir = ict_model();
   if (!dir) GTEST_SKIP() << "ICT-FaceKit is not in ../shared/data";
-  const HeadModel model = load_head_model(*dir, 0.01);
-  const Vertices neutral = subject_neutral(model);
-  const std::vector<Camera> cameras = synth::make_studio_rig({}).cameras;
-  const Options options = scan_only_options();
-
-  const TruthFrame rest = truth_frame(model, neutral, 0, {});
-  const Mesh rest_scan = scan_of(model, rest.world);
-  const SubjectIdentity subject = fit_identity(model, {{&rest_scan, {}}}, cameras, options, nullptr);
+  const Subject fixture(*dir);
+  const HeadModel& model = fixture.model;
+  const Vertices& neutral = fixture.neutral;
+  const std::vector<Camera>& cameras = fixture.cameras;
+  const Options& options = fixture.options;
+  const TruthFrame& rest = fixture.rest;
+  const SubjectIdentity& subject = fixture.fitted;
   std::vector<double> identity_errors;
   for (int v : model.fit_vertices) identity_errors.push_back((subject.neutral.row(v) - neutral.row(v)).norm());
   std::sort(identity_errors.begin(), identity_errors.end());
@@ -136,14 +152,9 @@ TEST(Tracker, FitsIdentityPoseAndExpressionToScansOfTheModel) {
 TEST(Tracker, AScanFarFromTheHeadIsRejectedNotTracked) {
   const auto dir = ict_model();
   if (!dir) GTEST_SKIP() << "ICT-FaceKit is not in ../shared/data";
-  const HeadModel model = load_head_model(*dir, 0.01);
-  const Vertices neutral = subject_neutral(model);
-  const std::vector<Camera> cameras = synth::make_studio_rig({}).cameras;
-  const Options options = scan_only_options();
-  const TruthFrame rest = truth_frame(model, neutral, 0, {});
-  const Mesh rest_scan = scan_of(model, rest.world);
-  const SubjectIdentity subject = fit_identity(model, {{&rest_scan, {}}}, cameras, options, nullptr);
-  TakeTracker tracker(model, subject, cameras, options, nullptr);
+  const Subject fixture(*dir);
+  const Mesh& rest_scan = fixture.rest_scan;
+  TakeTracker tracker(fixture.model, fixture.fitted, fixture.cameras, fixture.options, nullptr);
   const FrameFit first = tracker.track({&rest_scan, {}});
   ASSERT_FALSE(tracker.rejection(first).has_value());
   tracker.accept(first, {&rest_scan, {}});

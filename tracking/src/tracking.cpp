@@ -178,15 +178,9 @@ SubjectIdentity identity_of(const TrackRequest& request, const TakeInfo& first, 
 
 TrackSummary track_capture(const TrackRequest& request, const Options& options) {
   const CaptureInfo capture = read_capture(request.capture);
-  const fs::path rig_file = !request.rig.empty() ? request.rig
-                            : !capture.rig.empty() ? capture.root / capture.rig
-                                                   : capture.root / "rig.json";
+  const fs::path rig_file = capture.rig_file(request.rig);
   const Rig rig = read_rig_json(rig_file);
-  std::vector<std::string> takes = request.takes;
-  if (takes.empty())
-    for (const auto& take : capture.takes)
-      if (take.kind == "performance") takes.push_back(take.name);
-  if (takes.empty()) throw Error(request.capture / "capture.json", "lists no performance take to track");
+  const std::vector<std::string> takes = capture.performance_takes(request.takes, "to track");
   for (const auto& name : takes)
     if (!fs::is_directory(request.meshes / name))
       throw Error(request.meshes / name, "is missing: take " + name + " has no meshes (run tega mvs first)");

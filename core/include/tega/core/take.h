@@ -56,6 +56,12 @@ struct CaptureInfo {
   std::vector<CaptureTake> takes;
   std::string rig;  // relative path of the rig file, "" when none
   std::string generator;
+
+  // `chosen` when given, else the capture's rig file (rig.json when it names none).
+  std::filesystem::path rig_file(const std::filesystem::path& chosen = {}) const;
+  // `chosen` when given, else every performance take; throws tega::Error
+  // naming capture.json when that leaves none (`purpose`: "to track", ...).
+  std::vector<std::string> performance_takes(const std::vector<std::string>& chosen, const std::string& purpose) const;
 };
 
 // Reads capture.json (format "tega-capture", version 1). Throws tega::Error naming it.
