@@ -120,7 +120,7 @@ TEST(StudioTracking, TracksTegasOwnMeshesWithinTheTargets) {
   EXPECT_EQ(again.frames_kept, kFrames);
 
   // The landmark term, with a predictor the test trains on the even frames of
-  // the cameras that see all 68 landmarks (half the frames it then tracks are
+  // the cameras that see nearly all 68 landmarks (half the frames it then tracks are
   // new to it; landmark_test.cpp scores predictors on unseen frames).
   const auto indices = nlohmann::json::parse(read_text_file(*shared / "ict-facekit" / "vertex_indices.json"));
   const auto landmark_vertices = indices.at("idx_to_landmark_verts").get<std::vector<int>>();
@@ -128,11 +128,13 @@ TEST(StudioTracking, TracksTegasOwnMeshesWithinTheTargets) {
   for (const auto& camera : read_rig_json(capture / "rig.json").camera_names())
     for (int frame = 0; frame < kFrames; frame += 2) {
       LandmarkSample sample = studio_landmark_sample(capture, "expressions", camera, frame, landmark_vertices);
-      if (std::all_of(sample.landmarks.begin(), sample.landmarks.end(), [](const auto& l) { return l.allFinite(); }))
-        samples.push_back(std::move(sample));
+      const auto known = std::count_if(sample.landmarks.begin(), sample.landmarks.end(),
+                                       [](const Eigen::Vector2d& l) { return l.allFinite(); });
+      if (known >= kLandmarkCount - 8) samples.push_back(std::move(sample));  // the jaw line's far end may hide
     }
   LandmarkTrainingOptions training;
   training.threads = 2;
+  ASSERT_GE(samples.size(), 8u);
   train_landmark_predictor(samples, training, dir / "predictor.dat");
   Options with_landmarks = options;
   with_landmarks.identity = (dir / "tracked" / "identity.json").string();
