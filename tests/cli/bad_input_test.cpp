@@ -47,6 +47,20 @@ TEST(CliBadInput, MvsOnAMissingCaptureNamesIt) {
   EXPECT_NE(frames.output.find("--frames '9:3'"), std::string::npos) << frames.output;
 }
 
+TEST(CliBadInput, TrackNamesAMissingCaptureAndAMissingModel) {
+  tega::test::TempDir tmp;
+  const auto r = run_tega("track --capture " + (tmp / "nowhere").string() + " --meshes " + (tmp / "m").string() +
+                          " --model " + (tmp / "model").string() + " --out " + (tmp / "tracked").string());
+  if (r.output.find("could not be matched") != std::string::npos) GTEST_SKIP() << "this build has no tega track";
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find((tmp / "nowhere").string()), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(tmp / "tracked"));
+  const auto options = run_tega("track --print-options");
+  EXPECT_EQ(options.exit_code, 0) << options.output;
+  EXPECT_NE(options.output.find("  model: \"\""), std::string::npos) << options.output;
+  EXPECT_NE(options.output.find("landmarks:"), std::string::npos) << options.output;
+}
+
 TEST(CliRigConvert, KrtToJsonToColmapInMetres) {
   tega::test::TempDir tmp;
   tega::test::write_text(tmp / "KRT",
