@@ -14,19 +14,27 @@ struct SurfaceQuery::Scene {
 };
 
 SurfaceQuery::SurfaceQuery(const Mesh& surface)
-    : scene_(std::make_unique<Scene>()), tree_(surface), face_normals_(surface.num_faces(), 3) {
+    : surface_(surface), tree_(surface), face_normals_(surface.num_faces(), 3) {
   for (int f = 0; f < surface.num_faces(); ++f) {
     const Eigen::Vector3f a = surface.positions.row(surface.faces(f, 0)), b = surface.positions.row(surface.faces(f, 1)),
                           c = surface.positions.row(surface.faces(f, 2));
     face_normals_.row(f) = (b - a).cross(c - a).normalized().transpose();
   }
-  const int64_t n = surface.num_vertices(), m = surface.num_faces();
-  std::vector<float> positions(surface.positions.data(), surface.positions.data() + 3 * n);
-  std::vector<uint32_t> faces(3 * m);
-  for (int64_t f = 0; f < m; ++f)
-    for (int k = 0; k < 3; ++k) faces[3 * f + k] = static_cast<uint32_t>(surface.faces(f, k));
-  scene_->scene.AddTriangles(o3c::Tensor(positions, {n, 3}, o3c::Float32),
-                             o3c::Tensor(faces, {m, 3}, o3c::UInt32));
+}
+
+// Frames tracked without image terms never ask about occlusion: the
+// ray-casting scene is built on the first question only.
+SurfaceQuery::Scene& SurfaceQuery::scene() const {
+  std::call_once(scene_built_, [this] {
+    scene_ = std::make_unique<Scene>();
+    const int64_t n = surface_.num_vertices(), m = surface_.num_faces();
+    std::vector<float> positions(surface_.positions.data(), surface_.positions.data() + 3 * n);
+    std::vector<uint32_t> faces(3 * m);
+    for (int64_t f = 0; f < m; ++f)
+      for (int k = 0; k < 3; ++k) faces[3 * f + k] = static_cast<uint32_t>(surface_.faces(f, k));
+    scene_->scene.AddTriangles(o3c::Tensor(positions, {n, 3}, o3c::Float32), o3c::Tensor(faces, {m, 3}, o3c::UInt32));
+  });
+  return *scene_;
 }
 
 SurfaceQuery::~SurfaceQuery() = default;
@@ -60,7 +68,7 @@ std::vector<bool> SurfaceQuery::occluded(const Eigen::Vector3d& eye, const std::
   // One tfar for all rays: the margin measured on the nearest scale that
   // matters, the longest segment (the others get a slightly larger margin).
   const float tfar = static_cast<float>(1.0 - margin_m / std::max(longest, 1e-9));
-  const o3c::Tensor hits = scene_->scene.TestOcclusions(o3c::Tensor(rays, {n, 6}, o3c::Float32), 0.f, tfar).Contiguous();
+  const o3c::Tensor hits = scene().scene.TestOcclusions(o3c::Tensor(rays, {n, 6}, o3c::Float32), 0.f, tfar).Contiguous();
   const bool* h = hits.GetDataPtr<bool>();
   return std::vector<bool>(h, h + n);
 }

@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "tega/core/mesh.h"
@@ -34,9 +35,13 @@ class SurfaceQuery {
 
  private:
   struct Scene;
-  std::unique_ptr<Scene> scene_;
+  Scene& scene() const;
+
+  Mesh surface_;
   TriangleDistanceTree tree_;
   Vertices face_normals_;
+  mutable std::once_flag scene_built_;
+  mutable std::unique_ptr<Scene> scene_;
 };
 
 }  // namespace tega::tracking
