@@ -5,7 +5,6 @@
 #include "tega/core/undistort.h"
 
 namespace tega::mvs {
-namespace {
 
 Image8 recorded_rgb(const Image8& recorded, const TakeInfo& take, const RawToRgb& raw_to_rgb, const std::string& file) {
   const std::string& format = take.pixel_format;
@@ -23,8 +22,6 @@ Image8 recorded_rgb(const Image8& recorded, const TakeInfo& take, const RawToRgb
   throw Error(file, "has " + std::to_string(recorded.channels) + " channel(s), which does not fit the take's pixel format " +
                         format);
 }
-
-}  // namespace
 
 Image8 rgb_of(const Image8& image) {
   if (image.channels == 3) return image;

@@ -42,6 +42,11 @@ class FrameLoader {
   RawToRgb raw_to_rgb_;
 };
 
+// A recorded image of `take` (as read from `file`) as 8-bit RGB, by the
+// take's pixel format; tega::Error naming the file when its channels do not
+// fit the format, or it is raw Bayer and `raw_to_rgb` is empty.
+Image8 recorded_rgb(const Image8& recorded, const TakeInfo& take, const RawToRgb& raw_to_rgb, const std::string& file);
+
 // An 8-bit grey, grey + alpha, RGB or RGBA image as RGB (alpha dropped).
 Image8 rgb_of(const Image8& image);
 
