@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
               "corrections", "total (s)", "flow points", "flow rms px");
   double total = 0;
   int counted = 0;
-  std::vector<tracking::TrackedFrame> scored;
+  std::vector<tracking::ScoredFrame> scored;
   for (int frame = 0; frame < take.frames; ++frame) {
     const Mesh scan = scan_of(capture, meshes_dir, fine_topology, frame);
     const tracking::FrameObservation observation{&scan, photos(frame)};
@@ -108,7 +108,7 @@ int main(int argc, char** argv) {
     const tracking::FrameFit fit = tracker.track(observation);
     const double seconds = seconds_since(start);
     tracker.accept(fit, observation);
-    tracking::TrackedFrame t{frame, fit.vertices, fit.state.head_to_world.R, {}};
+    tracking::ScoredFrame t{frame, fit.vertices, fit.state.head_to_world.R, {}};
     for (size_t k = 0; k < fit.state.expression.size(); ++k)
       t.expression[model.shapes.expression_names[k]] = fit.state.expression[k];
     scored.push_back(std::move(t));

@@ -49,7 +49,7 @@ endif()
 
 set(TEGA_HAVE_OPENCV OFF)
 if(TEGA_WITH_OPENCV)
-  find_package(OpenCV QUIET COMPONENTS core imgproc aruco videoio calib3d)
+  find_package(OpenCV QUIET COMPONENTS core imgproc aruco videoio calib3d ximgproc)
   if(OpenCV_FOUND)
     set(TEGA_HAVE_OPENCV ON)
   else()

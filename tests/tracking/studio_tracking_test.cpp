@@ -97,7 +97,7 @@ TEST(StudioTracking, TracksTegasOwnMeshesWithinTheTargets) {
   options.threads = 2;
   const TrackSummary summary = track_capture({capture, {}, dir / "meshes", dir / "tracked", {}}, options);
   EXPECT_EQ(summary.frames_tracked, kFrames);
-  const TrackScores scores = score_against_studio(dir / "tracked" / "expressions", capture, "expressions");
+  const TrackScores scores = score_against_studio(dir / "tracked", capture, "expressions");
   print_scores("tega's MVS meshes", scores);
   expect_within(scores, {0.002, 0.007, 1.0, 0.95, 0.5});
 
@@ -141,7 +141,7 @@ TEST(StudioTracking, TracksTegasOwnMeshesWithinTheTargets) {
   with_landmarks.landmarks.model = (dir / "predictor.dat").string();
   track_capture({capture, {}, dir / "meshes", dir / "tracked_with_landmarks", {}}, with_landmarks);
   const TrackScores landmarked =
-      score_against_studio(dir / "tracked_with_landmarks" / "expressions", capture, "expressions");
+      score_against_studio(dir / "tracked_with_landmarks", capture, "expressions");
   print_scores("tega's MVS meshes, with landmarks", landmarked);
   expect_within(landmarked, Bounds{0.002, 0.007, 1.0, 0.95, 0.35});
   const auto with_points =
@@ -155,7 +155,7 @@ TEST(StudioTracking, TracksTegasOwnMeshesWithinTheTargets) {
   reuse.identity = (dir / "tracked" / "identity.json").string();
   reuse.flow.enabled = true;
   track_capture({capture, {}, dir / "true_meshes", dir / "tracked_on_truth", {}}, reuse);
-  const TrackScores bound = score_against_studio(dir / "tracked_on_truth" / "expressions", capture, "expressions");
+  const TrackScores bound = score_against_studio(dir / "tracked_on_truth", capture, "expressions");
   print_scores("true meshes, with flow", bound);
   expect_within(bound, {0.002, 0.005, 1.0, 0.95, 0.25});
   const auto flowed = nlohmann::json::parse(read_text_file(dir / "tracked_on_truth" / "expressions" / "000004.json"));

@@ -13,6 +13,7 @@
 #include "tega/core/mesh.h"
 #include "tega/core/rig.h"
 #include "tega/mvs/studio_truth.h"
+#include "tega/tracking/tracked.h"
 
 namespace tega::tracking {
 namespace fs = std::filesystem;
@@ -102,7 +103,7 @@ LandmarkSample studio_landmark_sample(const fs::path& capture, const std::string
   return sample;
 }
 
-TrackScores score_frames(const std::vector<TrackedFrame>& tracked, const fs::path& capture, const std::string& take) {
+TrackScores score_frames(const std::vector<ScoredFrame>& tracked, const fs::path& capture, const std::string& take) {
   const mvs::StudioTruth truth = mvs::load_studio_truth(capture, take, 0);
   const auto frames = read_json(capture / "ground_truth" / take / "frames.json");
   const Mesh coarse = read_obj(capture / "ground_truth" / "head" / "template.obj");
@@ -112,7 +113,7 @@ TrackScores score_frames(const std::vector<TrackedFrame>& tracked, const fs::pat
   TrackScores scores;
   std::vector<double> errors, rotations;
   std::map<std::string, std::pair<std::vector<double>, std::vector<double>>> series;  // truth, tracked
-  for (const TrackedFrame& t : tracked) {
+  for (const ScoredFrame& t : tracked) {
     if (!truth_frames.count(t.frame)) throw Error(capture / "ground_truth" / take / "frames.json", "has no frame " + std::to_string(t.frame));
     const nlohmann::json& truth_frame = *truth_frames.at(t.frame);
     char name[32];
@@ -145,22 +146,14 @@ TrackScores score_frames(const std::vector<TrackedFrame>& tracked, const fs::pat
   return scores;
 }
 
-TrackScores score_against_studio(const fs::path& tracked_take, const fs::path& capture, const std::string& take) {
-  std::vector<TrackedFrame> tracked;
-  for (const auto& entry : fs::directory_iterator(tracked_take)) {
-    if (entry.path().extension() != ".json" || entry.path().stem().string().size() != 6) continue;
-    const auto record = read_json(entry.path());
-    if (record.at("status") != "tracked") continue;
-    TrackedFrame t;
-    t.frame = record.at("frame");
-    t.vertices = read_vertices_bin(tracked_take / record.at("mesh").get<std::string>());
-    t.head_rotation = rotation_of(record.at("head_to_world"));
-    for (const auto& [name, value] : record.at("expression").items()) t.expression[name] = value.get<double>();
-    tracked.push_back(std::move(t));
+TrackScores score_against_studio(const fs::path& tracked, const fs::path& capture, const std::string& take) {
+  std::vector<ScoredFrame> scored;
+  for (const TrackedFrame& frame : read_tracked_take(tracked, take)) {
+    if (!frame.tracked()) continue;
+    scored.push_back({frame.frame, read_vertices_bin(frame.mesh), frame.head_to_world.R, frame.expression});
   }
-  std::sort(tracked.begin(), tracked.end(), [](const TrackedFrame& a, const TrackedFrame& b) { return a.frame < b.frame; });
-  if (tracked.empty()) throw Error(tracked_take, "has no tracked frame to score");
-  return score_frames(tracked, capture, take);
+  if (scored.empty()) throw Error(tracked / take, "has no tracked frame to score");
+  return score_frames(scored, capture, take);
 }
 
 }  // namespace tega::tracking

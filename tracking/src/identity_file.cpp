@@ -5,6 +5,7 @@
 #include "tega/core/error.h"
 #include "tega/core/files.h"
 #include "tega/tracking/tracking.h"
+#include "vertex_runs.h"
 
 namespace tega::tracking {
 namespace fs = std::filesystem;
@@ -22,6 +23,9 @@ void write_identity(const SubjectIdentity& subject, const HeadModel& model, cons
     coefficients[model.shapes.identity_names[k]] = subject.coefficients[k];
   j["identity"] = coefficients;
   j["neutral"] = mesh_file.filename().string();
+  // What later stages need of the model without loading it (tracked.h).
+  j["eyeball_vertex_runs"] = vertex_runs(model.eyeball_vertices);
+  j["landmark_vertices"] = model.landmark_vertices;
   write_text_atomic(file, j.dump(2) + "\n");
 }
 

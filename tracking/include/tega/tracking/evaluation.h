@@ -33,19 +33,27 @@ std::vector<int> studio_model_vertices(const std::filesystem::path& capture);
 LandmarkSample studio_landmark_sample(const std::filesystem::path& capture, const std::string& take,
                                       const std::string& camera, int frame, const std::vector<int>& landmark_vertices);
 
+// The studio's ground truth in tega track's layout (docs/layouts.md#tracked-meshes):
+// its template as the subject (identity.json, identity_neutral.obj) and the
+// true coarse meshes and poses as tracked frames of `takes` (empty: every
+// performance take). Stages after tracking are tested on it apart from the
+// tracker's own error. `out` must not exist.
+void write_studio_truth_as_tracked(const std::filesystem::path& capture, const std::filesystem::path& out,
+                                   const std::vector<std::string>& takes = {});
+
 // One tracked frame to score.
-struct TrackedFrame {
+struct ScoredFrame {
   int frame = 0;
   Vertices vertices;              // world space, the model's topology
   Eigen::Matrix3d head_rotation;  // of head_to_world
   std::map<std::string, double> expression;
 };
 
-TrackScores score_frames(const std::vector<TrackedFrame>& frames, const std::filesystem::path& capture,
+TrackScores score_frames(const std::vector<ScoredFrame>& frames, const std::filesystem::path& capture,
                          const std::string& take);
 
-// `tracked_take`: TRACKED/<take> (its tracked frames); `capture`: the studio's capture with ground_truth/.
-TrackScores score_against_studio(const std::filesystem::path& tracked_take, const std::filesystem::path& capture,
+// The tracked frames of TRACKED/<take>; `capture`: the studio's capture with ground_truth/.
+TrackScores score_against_studio(const std::filesystem::path& tracked, const std::filesystem::path& capture,
                                  const std::string& take);
 
 }  // namespace tega::tracking
