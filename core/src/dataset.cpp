@@ -201,4 +201,23 @@ void write_dataset_manifest(const Dataset& d) {
   write_text_atomic(d.root / kManifest, manifest.dump(1));
 }
 
+std::vector<size_t> evenly_spaced_indices(size_t total, int count) {
+  std::vector<size_t> picked;
+  if (count <= 0 || static_cast<size_t>(count) >= total) {
+    for (size_t i = 0; i < total; ++i) picked.push_back(i);
+    return picked;
+  }
+  for (int i = 0; i < count; ++i) picked.push_back(static_cast<size_t>((i + 0.5) * total / count));
+  return picked;
+}
+
+std::vector<std::string> spread_test_cameras(const Rig& rig, int count) {
+  const int n = static_cast<int>(rig.cameras.size());
+  if (n == 0) return {};
+  const int held_out = n == 1 ? 1 : std::clamp(count, 1, n - 1);
+  std::vector<std::string> names;
+  for (int i = 0; i < held_out; ++i) names.push_back(rig.cameras[(n - 1) - i * (n / held_out) % n].name);
+  return names;
+}
+
 }  // namespace tega

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "tega/core/dataset.h"
+#include "tega/core/downsample.h"
 #include "tega/core/error.h"
 #include "tega/core/files.h"
 #include "tega/core/image.h"
@@ -36,12 +37,9 @@ void check_options(const IngestOptions& o) {
   if (!o.face_forward.empty() && o.face_forward.size() != 3) fail("face_forward must be empty or 3 numbers");
 }
 
-// `count` entries at evenly spaced positions (the middle of each of `count`
-// equal parts); all of them when count is 0 or not smaller.
 std::vector<MultifaceFrame> sample_uniformly(const std::vector<MultifaceFrame>& all, int count) {
-  if (count <= 0 || static_cast<size_t>(count) >= all.size()) return all;
   std::vector<MultifaceFrame> picked;
-  for (int i = 0; i < count; ++i) picked.push_back(all[static_cast<size_t>((i + 0.5) * all.size() / count)]);
+  for (const size_t i : evenly_spaced_indices(all.size(), count)) picked.push_back(all[i]);
   return picked;
 }
 

@@ -17,15 +17,6 @@
 namespace tega::synth {
 namespace {
 
-// Held-out cameras spread over the layout rather than bunched together.
-std::vector<std::string> pick_test_cameras(const Rig& rig, int wanted) {
-  const int n = static_cast<int>(rig.cameras.size());
-  const int count = n == 1 ? 1 : std::clamp(wanted, 1, n - 1);
-  std::vector<std::string> out;
-  for (int i = 0; i < count; ++i) out.push_back(rig.cameras[(n - 1) - i * (n / count) % n].name);
-  return out;
-}
-
 void write_head_ground_truth(const std::filesystem::path& dir, const Head& head, const FineMeshMaker& maker) {
   std::filesystem::create_directories(dir);
   write_obj(head.model.neutral, dir / "template.obj");
@@ -150,7 +141,7 @@ SynthSummary render_virtual_studio(const Options& o, const std::filesystem::path
     dataset.frames.insert(dataset.frames.end(), frames.begin(), frames.end());
     summary.takes.push_back({take, "performance", o.frames});
   }
-  dataset.test.cameras = pick_test_cameras(rig, o.test_cameras);
+  dataset.test.cameras = spread_test_cameras(rig, o.test_cameras);
   for (const auto& name : rig.camera_names())
     if (std::find(dataset.test.cameras.begin(), dataset.test.cameras.end(), name) == dataset.test.cameras.end() ||
         n_cameras == 1)

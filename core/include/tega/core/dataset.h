@@ -63,4 +63,18 @@ void validate_dataset(const Dataset& dataset);
 // at mesh_path() and image_path().
 void write_dataset_manifest(const Dataset& dataset);
 
+// Choosing a dataset's frames and held-out cameras, the same way for every
+// producer (tega synth, tega ingest multiface, tega dataset build).
+
+// Indices of `count` of `total` items spread evenly (the middle of each of
+// `count` equal parts), ascending; all of them when count is 0 or not
+// smaller than total. The paper samples 400 frames this way over a
+// subject's takes.
+std::vector<size_t> evenly_spaced_indices(size_t total, int count);
+
+// `count` of the rig's cameras spread over its layout rather than bunched
+// together (every (n / count)-th, from the last), clamped to 1 .. n - 1, or
+// the only camera of a one-camera rig: the held-out views of a test split.
+std::vector<std::string> spread_test_cameras(const Rig& rig, int count);
+
 }  // namespace tega

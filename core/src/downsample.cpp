@@ -1,0 +1,37 @@
+#include "tega/core/downsample.h"
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "tega/core/error.h"
+
+namespace tega {
+
+Image8 box_downsample(const Image8& image, int factor) {
+  if (factor < 1 || image.width % factor != 0 || image.height % factor != 0) {
+    throw Error("downsample " + std::to_string(factor) + " does not divide the image size " +
+                std::to_string(image.width) + "x" + std::to_string(image.height));
+  }
+  if (factor == 1) return image;
+  Image8 out(image.width / factor, image.height / factor, image.channels);
+  const int area = factor * factor;
+  const size_t out_row = static_cast<size_t>(out.width) * image.channels;
+  // Block sums one output row at a time, adding input rows left to right:
+  // memory is read in order, which matters at 26 megapixels.
+  std::vector<int> sums(out_row);
+  for (int y = 0; y < out.height; ++y) {
+    std::fill(sums.begin(), sums.end(), 0);
+    for (int dy = 0; dy < factor; ++dy) {
+      const uint8_t* in = &image.at(0, y * factor + dy, 0);
+      for (int x = 0; x < out.width; ++x)
+        for (int dx = 0; dx < factor; ++dx)
+          for (int c = 0; c < image.channels; ++c) sums[static_cast<size_t>(x) * image.channels + c] += *in++;
+    }
+    uint8_t* row = &out.at(0, y, 0);
+    for (size_t i = 0; i < out_row; ++i) row[i] = static_cast<uint8_t>((sums[i] + area / 2) / area);
+  }
+  return out;
+}
+
+}  // namespace tega
