@@ -42,10 +42,9 @@ std::vector<TrackedFrame> read_tracked_take(const fs::path& tracked, const std::
     throw Error(dir / "track.json", "is missing: take " + take + " was not tracked to its end (run tega track)");
   std::vector<fs::path> records;
   for (const auto& entry : fs::directory_iterator(dir)) {
-    const fs::path& p = entry.path();
-    if (p.extension() == ".json" && p.stem().string().size() == 6 &&
-        std::all_of(p.stem().string().begin(), p.stem().string().end(), ::isdigit))
-      records.push_back(p);
+    const std::string stem = entry.path().stem().string();
+    if (entry.path().extension() == ".json" && stem.size() == 6 && std::all_of(stem.begin(), stem.end(), ::isdigit))
+      records.push_back(entry.path());
   }
   std::sort(records.begin(), records.end());
   std::vector<TrackedFrame> frames;

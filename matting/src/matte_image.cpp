@@ -1,0 +1,248 @@
+// One image's matte (docs/matting.md#the-method).
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/ximgproc/edge_filter.hpp>
+#include <vector>
+
+#include "tega/core/error.h"
+#include "tega/matting/matte.h"
+
+namespace tega::matting {
+namespace {
+
+cv::Mat view_of(const Image8& image) {
+  return cv::Mat(image.height, image.width, CV_8UC(image.channels), const_cast<uint8_t*>(image.pixels.data()));
+}
+
+// Distance of every pixel to the nearest pixel outside `mask` (0 outside it).
+cv::Mat distance_inside(const cv::Mat& mask) {
+  cv::Mat distance;
+  cv::distanceTransform(mask, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  return distance;
+}
+cv::Mat distance_outside(const cv::Mat& mask) { return distance_inside(mask == 0); }
+
+double median_of(std::vector<float>& values) {
+  if (values.empty()) return 0;
+  auto mid = values.begin() + long(values.size() / 2);
+  std::nth_element(values.begin(), mid, values.end());
+  return *mid;
+}
+
+// Every few pixels where `where` holds: enough for robust statistics.
+std::vector<cv::Point> sample_points(const cv::Mat& where, int target = 200000) {
+  const int step = std::max(1, int(std::sqrt(double(where.total()) / target)));
+  std::vector<cv::Point> points;
+  for (int y = 0; y < where.rows; y += step)
+    for (int x = 0; x < where.cols; x += step)
+      if (where.at<uint8_t>(y, x)) points.emplace_back(x, y);
+  return points;
+}
+
+// The clean plate under the frame's exposure: a per-channel gain measured on
+// the far background, where the plate and the frame show the same thing.
+cv::Mat exposed_plate(const cv::Mat& photo, const cv::Mat& plate, const std::vector<cv::Point>& background,
+                      double max_change) {
+  cv::Vec3f gain(1, 1, 1);
+  for (int c = 0; c < 3; ++c) {
+    std::vector<float> ratios;
+    for (const auto& p : background) {
+      const float b = plate.at<cv::Vec3f>(p)[c];
+      if (b > 0.04f) ratios.push_back(photo.at<cv::Vec3f>(p)[c] / b);
+    }
+    if (ratios.size() > 100) gain[c] = float(std::clamp(median_of(ratios), 1 - max_change, 1 + max_change));
+  }
+  cv::Mat exposed;
+  cv::multiply(plate, cv::Scalar(gain[0], gain[1], gain[2]), exposed);
+  return exposed;
+}
+
+// The noise of the difference photo - plate, from its median absolute deviation.
+double difference_noise(const cv::Mat& difference, const std::vector<cv::Point>& background) {
+  std::vector<float> values;
+  values.reserve(background.size() * 3);
+  for (const auto& p : background)
+    for (int c = 0; c < 3; ++c) values.push_back(difference.at<cv::Vec3f>(p)[c]);
+  const float centre = float(median_of(values));
+  for (float& v : values) v = std::abs(v - centre);
+  return 1.4826 * median_of(values);
+}
+
+cv::Mat disk(int radius) {
+  return cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1));
+}
+
+// Subject regions that touch `anchor`, with the holes that lie within
+// `possible` filled (a pupil as dark as the backdrop is still the head).
+cv::Mat connected_subject(const cv::Mat& subject, const cv::Mat& anchor, const cv::Mat& possible, bool connected_only) {
+  cv::Mat labels;
+  const int count = cv::connectedComponents(subject, labels, 8, CV_32S);
+  std::vector<uint8_t> keep(size_t(count), connected_only ? 0 : 1);
+  keep[0] = 0;
+  if (connected_only)
+    for (int y = 0; y < subject.rows; ++y)
+      for (int x = 0; x < subject.cols; ++x)
+        if (anchor.at<uint8_t>(y, x)) keep[size_t(labels.at<int>(y, x))] = 1;
+  cv::Mat kept(subject.size(), CV_8U);
+  for (int y = 0; y < subject.rows; ++y)
+    for (int x = 0; x < subject.cols; ++x) kept.at<uint8_t>(y, x) = keep[size_t(labels.at<int>(y, x))] ? 255 : 0;
+
+  const int holes = cv::connectedComponents(kept == 0, labels, 4, CV_32S);
+  std::vector<uint8_t> fill(size_t(holes), 1);
+  fill[0] = 0;
+  for (int y = 0; y < subject.rows; ++y) {
+    for (int x = 0; x < subject.cols; ++x) {
+      const int l = labels.at<int>(y, x);
+      const bool border = x == 0 || y == 0 || x == subject.cols - 1 || y == subject.rows - 1;
+      if (border || !possible.at<uint8_t>(y, x)) fill[size_t(l)] = 0;
+    }
+  }
+  for (int y = 0; y < subject.rows; ++y)
+    for (int x = 0; x < subject.cols; ++x)
+      if (fill[size_t(labels.at<int>(y, x))]) kept.at<uint8_t>(y, x) = 255;
+  return kept;
+}
+
+// Mean colour of the `known` pixels around each pixel, over ever larger
+// windows until some are found: the subject's colour just inside its edge.
+cv::Mat nearby_colour(const cv::Mat& colour, const cv::Mat& known, int radius) {
+  cv::Mat weight;
+  known.convertTo(weight, CV_32F, 1.0 / 255);
+  cv::Mat weighted;
+  cv::Mat weight3;
+  cv::merge(std::vector<cv::Mat>{weight, weight, weight}, weight3);
+  cv::multiply(colour, weight3, weighted);
+  cv::Mat result(colour.size(), CV_32FC3, cv::Scalar::all(-1));
+  for (int r = radius; r <= 8 * radius; r *= 2) {
+    cv::Mat sum, total;
+    cv::boxFilter(weighted, sum, -1, cv::Size(2 * r + 1, 2 * r + 1), cv::Point(-1, -1), false);
+    cv::boxFilter(weight, total, -1, cv::Size(2 * r + 1, 2 * r + 1), cv::Point(-1, -1), false);
+    for (int y = 0; y < colour.rows; ++y)
+      for (int x = 0; x < colour.cols; ++x)
+        if (result.at<cv::Vec3f>(y, x)[0] < 0 && total.at<float>(y, x) > 0.5f)
+          result.at<cv::Vec3f>(y, x) = sum.at<cv::Vec3f>(y, x) / total.at<float>(y, x);
+  }
+  return result;
+}
+
+cv::Rect grown(const cv::Rect& r, int by, const cv::Size& size) {
+  return cv::Rect(r.x - by, r.y - by, r.width + 2 * by, r.height + 2 * by) & cv::Rect(cv::Point(0, 0), size);
+}
+
+Image8 image_of(const cv::Mat& alpha) {
+  Image8 out(alpha.cols, alpha.rows, 1);
+  cv::Mat view = view_of(out);
+  alpha.convertTo(view, CV_8U, 255.0);
+  return out;
+}
+
+// Without a clean plate: the silhouette, its uncertain margin decided by a
+// guided filter along the photo's edges.
+Image8 mesh_only_matte(const cv::Mat& photo8, const cv::Mat& silhouette, int margin, const MatteOptions& options) {
+  const cv::Mat inside = distance_inside(silhouette), outside = distance_outside(silhouette);
+  cv::Mat alpha;
+  silhouette.convertTo(alpha, CV_32F, 1.0 / 255);
+  cv::Mat filtered;
+  cv::ximgproc::guidedFilter(photo8, alpha, filtered, margin, options.edge.guided_filter_eps);
+  for (int y = 0; y < alpha.rows; ++y) {
+    for (int x = 0; x < alpha.cols; ++x) {
+      float& a = alpha.at<float>(y, x);
+      if (inside.at<float>(y, x) > margin) a = 1;
+      else if (outside.at<float>(y, x) > margin) a = 0;
+      else a = std::clamp(filtered.at<float>(y, x), 0.0f, 1.0f);
+    }
+  }
+  return image_of(alpha);
+}
+
+}  // namespace
+
+Image8 compute_matte(const Image8& photo, const Image8* clean_plate, const Image8& silhouette, double margin_px,
+                     const MatteOptions& options) {
+  if (photo.channels != 3) throw Error("compute_matte: the photo must be RGB");
+  const auto same_size = [&](const Image8& other) { return other.width == photo.width && other.height == photo.height; };
+  if (!same_size(silhouette) || silhouette.channels != 1 || (clean_plate && (!same_size(*clean_plate) || clean_plate->channels != 3)))
+    throw Error("compute_matte: the photo, its clean plate and the mesh silhouette differ in size");
+  const cv::Mat photo8 = view_of(photo), mesh = view_of(silhouette);
+  const int margin = std::max(1, int(std::lround(margin_px)));
+  if (!clean_plate) return mesh_only_matte(photo8, mesh, margin, options);
+
+  const cv::Mat inside_mesh = distance_inside(mesh), outside_mesh = distance_outside(mesh);
+  const cv::Mat certain = inside_mesh > margin;  // subject whatever the plate says
+  const cv::Mat possible = outside_mesh <= margin;
+  const int band = std::max(1, options.edge.band_px);
+  const std::vector<cv::Point> far = sample_points(outside_mesh > margin + 4 * band);
+
+  cv::Mat image, plate;
+  photo8.convertTo(image, CV_32FC3, 1.0 / 255);
+  view_of(*clean_plate).convertTo(plate, CV_32FC3, 1.0 / 255);
+  plate = exposed_plate(image, plate, far, options.difference.max_exposure_change);
+  const cv::Mat difference = image - plate;
+  const double noise = options.difference.noise_sigma > 0 ? options.difference.noise_sigma
+                                                          : std::max(1e-3, difference_noise(difference, far));
+
+  // Subject: where the 3x3 mean difference stands out of its noise (a third
+  // of one pixel's), cleaned, joined with the certain head, its holes filled.
+  cv::Mat mean_difference;
+  cv::blur(difference, mean_difference, cv::Size(3, 3));
+  cv::Mat squared;
+  cv::multiply(mean_difference, mean_difference, squared);
+  cv::Mat distance2 = squared.reshape(1, int(squared.total())).clone();
+  cv::reduce(distance2, distance2, 1, cv::REDUCE_SUM);
+  distance2 = distance2.reshape(1, image.rows);
+  const double threshold = options.difference.subject_sigmas * noise / 3;
+  cv::Mat subject = distance2 > threshold * threshold;
+  if (options.difference.open_px > 0) cv::morphologyEx(subject, subject, cv::MORPH_OPEN, disk(options.difference.open_px));
+  if (options.difference.close_px > 0) cv::morphologyEx(subject, subject, cv::MORPH_CLOSE, disk(options.difference.close_px));
+  subject |= certain;
+  subject = connected_subject(subject, certain, possible, options.mesh.keep_connected_only && cv::countNonZero(certain) > 0);
+
+  // The band around the edge, where alpha is fractional; the work stays in
+  // its bounding box.
+  const cv::Mat band_mask =
+      ((distance_inside(subject) <= band) & subject) | ((distance_outside(subject) <= band) & (subject == 0));
+  cv::Mat alpha;
+  subject.convertTo(alpha, CV_32F, 1.0 / 255);
+  const cv::Rect box = cv::boundingRect(band_mask);
+  if (box.area() == 0) return image_of(alpha);
+  const cv::Rect roi = grown(box, 8 * (2 * band + 1), image.size());
+  const cv::Mat in_band = band_mask(roi), known_subject = subject(roi) & (in_band == 0);
+  const cv::Mat colour = image(roi), background = plate(roi);
+  const cv::Mat subject_colour = nearby_colour(colour, known_subject, 2 * band + 1);
+  cv::Mat smooth_mask;
+  cv::blur(alpha(roi), smooth_mask, cv::Size(3, 3));
+
+  // Unmixing I = a F + (1 - a) B against the known background B, trusted as
+  // far as F and B differ.
+  cv::Mat unmixed = alpha(roi).clone();
+  const float contrast2 = float(options.edge.min_contrast * options.edge.min_contrast);
+  for (int y = 0; y < roi.height; ++y) {
+    for (int x = 0; x < roi.width; ++x) {
+      if (!in_band.at<uint8_t>(y, x)) continue;
+      const cv::Vec3f F = subject_colour.at<cv::Vec3f>(y, x), B = background.at<cv::Vec3f>(y, x);
+      const float prior = smooth_mask.at<float>(y, x);
+      if (F[0] < 0) {
+        unmixed.at<float>(y, x) = prior;
+        continue;
+      }
+      const cv::Vec3f d = F - B;
+      const float d2 = d.dot(d);
+      const float a = d2 > 0 ? std::clamp((colour.at<cv::Vec3f>(y, x) - B).dot(d) / d2, 0.0f, 1.0f) : prior;
+      const float trust = d2 / (d2 + contrast2);
+      unmixed.at<float>(y, x) = trust * a + (1 - trust) * prior;
+    }
+  }
+  if (options.edge.guided_filter_radius_px > 0) {
+    cv::Mat filtered;
+    cv::ximgproc::guidedFilter(photo8(roi), unmixed, filtered, options.edge.guided_filter_radius_px,
+                               options.edge.guided_filter_eps);
+    filtered.copyTo(unmixed, in_band);
+  }
+  cv::Mat target = alpha(roi);
+  unmixed.copyTo(target, in_band);
+  cv::min(cv::max(alpha, 0.0), 1.0, alpha);
+  return image_of(alpha);
+}
+
+}  // namespace tega::matting
