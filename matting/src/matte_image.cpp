@@ -58,7 +58,7 @@ cv::Mat exposed_plate(const cv::Mat& photo, const cv::Mat& plate, const std::vec
   return exposed;
 }
 
-// The noise of the difference photo - plate, from its median absolute deviation.
+// The noise of a difference photo - plate, from its median absolute deviation.
 double difference_noise(const cv::Mat& difference, const std::vector<cv::Point>& background) {
   std::vector<float> values;
   values.reserve(background.size() * 3);
@@ -67,6 +67,25 @@ double difference_noise(const cv::Mat& difference, const std::vector<cv::Point>&
   const float centre = float(median_of(values));
   for (float& v : values) v = std::abs(v - centre);
   return 1.4826 * median_of(values);
+}
+
+// The part of photo - plate that a change of shading within 1 +- `shading`
+// does not explain (a shadow on the backdrop, a passing cloud): per pixel,
+// the plate scaled by the factor that best matches the photo, clamped to that
+// range, is subtracted (brightness and colour distortion, Horprasert et al.).
+cv::Mat unexplained(const cv::Mat& photo, const cv::Mat& plate, double shading) {
+  if (shading <= 0) return photo - plate;
+  cv::Mat out(photo.size(), CV_32FC3);
+  const float low = float(1 - shading), high = float(1 + shading);
+  for (int y = 0; y < photo.rows; ++y) {
+    for (int x = 0; x < photo.cols; ++x) {
+      const cv::Vec3f I = photo.at<cv::Vec3f>(y, x), B = plate.at<cv::Vec3f>(y, x);
+      const float b2 = B.dot(B);
+      const float k = b2 > 1e-6f ? std::clamp(I.dot(B) / b2, low, high) : 1.0f;
+      out.at<cv::Vec3f>(y, x) = I - k * B;
+    }
+  }
+  return out;
 }
 
 cv::Mat disk(int radius) {
@@ -178,20 +197,23 @@ Image8 compute_matte(const Image8& photo, const Image8* clean_plate, const Image
   photo8.convertTo(image, CV_32FC3, 1.0 / 255);
   view_of(*clean_plate).convertTo(plate, CV_32FC3, 1.0 / 255);
   plate = exposed_plate(image, plate, far, options.difference.max_exposure_change);
-  const cv::Mat difference = image - plate;
-  const double noise = options.difference.noise_sigma > 0 ? options.difference.noise_sigma
-                                                          : std::max(1e-3, difference_noise(difference, far));
-
-  // Subject: where the 3x3 mean difference stands out of its noise (a third
-  // of one pixel's), cleaned, joined with the certain head, its holes filled.
-  cv::Mat mean_difference;
-  cv::blur(difference, mean_difference, cv::Size(3, 3));
+  // Subject: where the 3x3 mean difference stands out of that mean's noise,
+  // measured on the far background (real noise is correlated: a third of one
+  // pixel's would be too optimistic), cleaned, joined with the certain head,
+  // its holes filled.
+  const double shading = options.difference.shading_tolerance;
+  cv::Mat image_mean, plate_mean;
+  cv::blur(image, image_mean, cv::Size(3, 3));
+  cv::blur(plate, plate_mean, cv::Size(3, 3));
+  const cv::Mat mean_difference = unexplained(image_mean, plate_mean, shading);
+  const double noise = options.difference.noise_sigma > 0 ? options.difference.noise_sigma / 3
+                                                          : std::max(3e-4, difference_noise(mean_difference, far));
   cv::Mat squared;
   cv::multiply(mean_difference, mean_difference, squared);
   cv::Mat distance2 = squared.reshape(1, int(squared.total())).clone();
   cv::reduce(distance2, distance2, 1, cv::REDUCE_SUM);
   distance2 = distance2.reshape(1, image.rows);
-  const double threshold = options.difference.subject_sigmas * noise / 3;
+  const double threshold = options.difference.subject_sigmas * noise;
   cv::Mat subject = distance2 > threshold * threshold;
   if (options.difference.open_px > 0) cv::morphologyEx(subject, subject, cv::MORPH_OPEN, disk(options.difference.open_px));
   if (options.difference.close_px > 0) cv::morphologyEx(subject, subject, cv::MORPH_CLOSE, disk(options.difference.close_px));

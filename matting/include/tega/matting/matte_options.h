@@ -9,8 +9,9 @@ namespace tega::matting {
 // the same camera's image of the empty studio, after matching its exposure.
 struct DifferenceOptions {
   double noise_sigma = 0;         // sensor noise, [0, 1] units; 0: measured per image on the far background
-  double subject_sigmas = 6;      // a difference above this many noise sigmas (3 x 3 mean) is subject
+  double subject_sigmas = 6;      // a 3 x 3 mean difference above this many of its noise sigmas is subject
   double max_exposure_change = 0.3;  // the frame's gain against the clean plate is clamped to 1 +- this
+  double shading_tolerance = 0;   // per-pixel brightness change explained as shading, not subject: 1 +- this
   int open_px = 1;                // subject specks narrower than this are dropped
   int close_px = 2;               // gaps in the subject narrower than this are closed
 
@@ -19,10 +20,15 @@ struct DifferenceOptions {
     v("noise_sigma", noise_sigma,
       "Sensor noise of one pixel (0..1 units); 0: measured on each image's background, far from the subject.");
     v("subject_sigmas", subject_sigmas,
-      "A pixel whose 3x3 mean differs from the clean plate by more than this many noise sigmas is subject.");
+      "A pixel whose 3x3 mean differs from the clean plate by more than this many sigmas of that mean's noise is "
+      "subject.");
     v("max_exposure_change", max_exposure_change,
       "Largest exposure drift corrected: the per-channel gain of a frame against its clean plate stays within "
       "1 +- this.");
+    v("shading_tolerance", shading_tolerance,
+      "A pixel as much as this much brighter or darker than the clean plate, with its colour, is still "
+      "background (a shadow cast on the backdrop, a change of daylight); 0 for the studio's fixed light. Dark "
+      "hair on a grey backdrop is a darker grey: keep this below its contrast.");
     v("open_px", open_px, "Specks of subject narrower than this many pixels are dropped (a morphological opening).");
     v("close_px", close_px, "Gaps in the subject narrower than this many pixels are closed.");
   }
