@@ -16,6 +16,7 @@
 #include "tega/core/undistort.h"
 #include "tega/mvs/colmap_workspace.h"
 #include "tega/mvs/debayer.h"
+#include "tega/mvs/frame_pipeline.h"
 #include "tega/mvs/frame_views.h"
 #include "tega/mvs/view_selection.h"
 
@@ -79,8 +80,11 @@ void parse_frame_range(const std::string& text, int& first, int& end) {
   if (end != -1 && end <= first) throw Error("--frames '" + text + "': the range is empty");
 }
 
-FrameReconstruction reconstruct_views(const std::vector<StereoView>& views, const Options& options, Device device,
-                                      const std::string& label, ThreadPool& pool) {
+namespace {
+
+// The first half of a frame: source views, depth ranges and the depth maps.
+FrameReconstruction estimate_depth(const std::vector<StereoView>& views, const Options& options, Device device,
+                                   const std::string& label, ThreadPool& pool) {
   std::vector<int> seeing;
   for (int k = 0; k < int(views.size()); ++k)
     if (sees_subject(views[k], options.mask)) seeing.push_back(k);
@@ -125,11 +129,16 @@ FrameReconstruction reconstruct_views(const std::vector<StereoView>& views, cons
     tasks.push_back(std::move(task));
   }
 
-  auto start = Clock::now();
+  const auto start = Clock::now();
   result.depth_maps = estimate_depth_maps(views, tasks, options.patch_match, device, &pool);
   result.timings.depth_s = seconds_since(start);
+  return result;
+}
 
-  start = Clock::now();
+// The second half: fusion and the surface.
+void fuse_and_mesh(const std::vector<StereoView>& views, const Options& options, const std::string& label,
+                   ThreadPool& pool, FrameReconstruction& result) {
+  auto start = Clock::now();
   result.cloud = fuse_depth_maps(views, result.map_views, result.depth_maps, options.fusion, &pool);
   result.timings.fusion_s = seconds_since(start);
   if (result.cloud.size() < 100)
@@ -141,6 +150,14 @@ FrameReconstruction reconstruct_views(const std::vector<StereoView>& views, cons
   if (surface.threads == 0) surface.threads = pool.size();
   result.mesh = reconstruct_surface(result.cloud, surface);
   result.timings.surface_s = seconds_since(start);
+}
+
+}  // namespace
+
+FrameReconstruction reconstruct_views(const std::vector<StereoView>& views, const Options& options, Device device,
+                                      const std::string& label, ThreadPool& pool) {
+  FrameReconstruction result = estimate_depth(views, options, device, label, pool);
+  fuse_and_mesh(views, options, label, pool, result);
   return result;
 }
 
@@ -212,46 +229,82 @@ struct TakeJob {
   std::string done_key;  // options and rig: what a finished frame was made with
 };
 
+std::string frame_label(const TakeInfo& take, int frame) {
+  return "take " + take.name + " frame " + std::to_string(frame);
+}
+
+// Runs `work`, naming the frame in the tega::Error it throws.
+template <class Work>
+auto naming_the_frame(const std::string& label, Work&& work) {
+  try {
+    return work();
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    throw Error(message.rfind(label, 0) == 0 ? message : label + ": " + message);
+  }
+}
+
+// A frame after its first half (views and depth maps); empty where an earlier run made it.
+struct PreparedFrame {
+  std::vector<StereoView> views;
+  FrameReconstruction reconstruction;
+  bool done_before = false;
+};
+
+// Frames overlap (frame_pipeline.h): the next frame loads and gets its depth
+// maps, mostly on the GPU, while this one is fused, meshed and written on the
+// CPU. Both halves share the pool.
 void reconstruct_frames(const TakeJob& job, const Options& options, MvsSummary& summary, ThreadPool& pool) {
   const TakeInfo& take = job.loader.take();
   fs::create_directories(job.out);
   Progress progress("mvs " + take.name, job.end - job.first, "frames");
-  for (int frame = job.first; frame < job.end; ++frame) {
+  const auto prepare = [&](int frame) {
+    PreparedFrame prepared;
     if (frame_done(job.out, frame, job.done_key)) {
-      ++summary.frames_skipped;
-      progress.advance();
-      continue;
+      prepared.done_before = true;
+      return prepared;
     }
-    const std::string label = "take " + take.name + " frame " + std::to_string(frame);
-    try {
-      auto start = Clock::now();
-      std::vector<StereoView> views = job.loader.load(frame, pool);
-      pool.parallel_for(0, int64_t(views.size()), [&](int64_t k) {
-        StereoView& view = views[size_t(k)];
+    const std::string label = frame_label(take, frame);
+    return naming_the_frame(label, [&] {
+      const auto start = Clock::now();
+      prepared.views = job.loader.load(frame, pool);
+      pool.parallel_for(0, int64_t(prepared.views.size()), [&](int64_t k) {
+        StereoView& view = prepared.views[size_t(k)];
         const auto plate = job.plates.find(view.camera.name);
         if (plate != job.plates.end()) view.mask = subject_mask(view.colour, plate->second, options.mask);
       });
       const double load_s = seconds_since(start);
-      FrameReconstruction r = reconstruct_views(views, options, summary.device, label, pool);
-      r.timings.load_s = load_s;
-
-      start = Clock::now();
+      prepared.reconstruction = estimate_depth(prepared.views, options, summary.device, label, pool);
+      prepared.reconstruction.timings.load_s = load_s;
+      return std::move(prepared);
+    });
+  };
+  const auto finish = [&](int frame, PreparedFrame prepared) {
+    if (prepared.done_before) {
+      ++summary.frames_skipped;
+      progress.advance();
+      return;
+    }
+    const std::string label = frame_label(take, frame);
+    const std::vector<StereoView>& views = prepared.views;
+    FrameReconstruction& r = prepared.reconstruction;
+    naming_the_frame(label, [&] {
+      fuse_and_mesh(views, options, label, pool, r);
+      const auto start = Clock::now();
       if (options.write_workspace) write_frame_workspace(views, r, job.out / "colmap" / frame_name(frame));
       write_mesh(r.mesh, job.out / (frame_name(frame) + ".ply"));
       r.timings.write_s = seconds_since(start);
       // Written last: its presence marks the frame done.
       write_text_atomic(job.out / (frame_name(frame) + ".json"), frame_record(frame, views, r, job.done_key).dump(2));
-      const auto& t = r.timings;
-      logging::info("%s: %zu depth maps, %d points, %d faces; load %.1f s, depth %.1f s, fusion %.1f s, surface %.1f s",
-                    label.c_str(), r.depth_maps.size(), r.cloud.size(), r.mesh.num_faces(), t.load_s, t.depth_s,
-                    t.fusion_s, t.surface_s);
-    } catch (const Error& e) {
-      const std::string message = e.what();
-      throw Error(message.rfind(label, 0) == 0 ? message : label + ": " + message);
-    }
+    });
+    const auto& t = r.timings;
+    logging::info("%s: %zu depth maps, %d points, %d faces; load %.1f s, depth %.1f s, fusion %.1f s, surface %.1f s",
+                  label.c_str(), r.depth_maps.size(), r.cloud.size(), r.mesh.num_faces(), t.load_s, t.depth_s,
+                  t.fusion_s, t.surface_s);
     ++summary.frames_done;
     progress.advance();
-  }
+  };
+  for_each_frame_overlapped(job.first, job.end, prepare, finish);
   progress.finish();
 }
 
