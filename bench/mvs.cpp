@@ -2,19 +2,22 @@
 // each stage timed (load, depth, fusion, surface) and scored against the
 // studio's ground truth: depth maps against rendered true depth, and (where
 // tega_mvs_surface is built, Open3D) the mesh's accuracy and completeness over
-// the face.
+// the face. With --take-frames N, then frames 0 to N - 1 overlapped as
+// `tega mvs` runs a take (frame_pipeline.h): the seconds per frame of a take.
 // The capture is rendered once into --capture and kept for the next run.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <numeric>
 
 #include "tega/core/log.h"
 #include "tega/core/mesh.h"
 #include "tega/core/thread_pool.h"
 #include "tega/core/undistort.h"
 #include "tega/mvs/colmap_workspace.h"
+#include "tega/mvs/frame_pipeline.h"
 #include "tega/mvs/frame_views.h"
 #include "tega/mvs/fusion.h"
 #include "tega/mvs/patch_match.h"
@@ -40,14 +43,16 @@ namespace {
 
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
-fs::path render_capture(const fs::path& root, int cameras, int width, int height) {
-  if (fs::exists(root / "capture.json")) return root;
-  std::printf("rendering %d cameras at %dx%d into %s (once)...\n", cameras, width, height, root.c_str());
+// Renders again where the kept capture has fewer frames than asked for.
+fs::path render_capture(const fs::path& root, int cameras, int width, int height, int frames) {
+  if (fs::exists(root / "capture.json") && read_take(root / "takes" / "expressions").frames >= frames) return root;
+  std::printf("rendering %d cameras at %dx%d, %d frames, into %s (once)...\n", cameras, width, height, frames,
+              root.c_str());
   synth::Options o;
   o.studio.cameras = cameras;
   o.studio.width = width;
   o.studio.height = height;
-  o.frames = 2;
+  o.frames = frames;
   o.calibration_frames = 0;
   o.takes = {"expressions"};
   o.test_takes = {};
@@ -104,13 +109,45 @@ void report_mesh(const Mesh& mesh, const fs::path& root, int frame) {
 }
 #endif
 
+struct FrameTimes {
+  double load_s = 0, depth_s = 0, fusion_s = 0, surface_s = 0;
+};
+
+void print_times(const FrameTimes& t, const char* indent) {
+  std::printf("%s%-10s %8.2f\n%s%-10s %8.2f\n%s%-10s %8.2f\n%s%-10s %8.2f\n%s%-10s %8.2f\n", indent, "load", t.load_s,
+              indent, "depth", t.depth_s, indent, "fusion", t.fusion_s, indent, "surface", t.surface_s, indent, "total",
+              t.load_s + t.depth_s + t.fusion_s + t.surface_s);
+}
+
+struct PreparedFrame {
+  std::vector<mvs::StereoView> views;
+  std::vector<mvs::DepthMap> maps;
+  mvs::OrientedPointCloud cloud;
+  Mesh mesh;
+  FrameTimes times;
+};
+
+// Every view gets a depth map, its depths searched 0.3 m either side of the rig's focus point.
+std::vector<mvs::ViewTask> view_tasks(const std::vector<mvs::StereoView>& views, const mvs::PatchMatchOptions& pm) {
+  std::vector<Camera> pinholes;
+  for (const auto& v : views) pinholes.push_back(v.camera);
+  const Eigen::Vector3d focus = *mvs::rig_focus_point(pinholes);
+  const auto sources = mvs::select_source_views(pinholes, focus, pm.source_views);
+  std::vector<mvs::ViewTask> tasks;
+  for (size_t k = 0; k < views.size(); ++k) {
+    const double centre = views[k].camera.world_to_camera.apply(focus).z();
+    tasks.push_back({int(k), sources[k], float(centre - 0.3), float(centre + 0.3)});
+  }
+  return tasks;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"Multi-view stereo time and accuracy on one virtual-studio frame."};
   int cameras = 13, width = 512, height = 384, frame = 0, threads = 0, window_radius = 0, window_step = 0,
       fusion_step = 0, iterations = 0, geometric_iterations = 0, pyramid_levels = -1, refine_passes = -1,
-      refine_iterations = 0, poisson_depth = 0, surface_threads = 0;
+      refine_iterations = 0, poisson_depth = 0, surface_threads = 0, take_frames = 0;
   double voxel_size = 0;
   std::string cloud_file;
   bool verbose = false;
@@ -119,6 +156,8 @@ int main(int argc, char** argv) {
   app.add_option("--width", width, "Image width.");
   app.add_option("--height", height, "Image height.");
   app.add_option("--frame", frame, "Frame of the take.");
+  app.add_option("--take-frames", take_frames,
+                 "Then mesh frames 0 to N - 1 of the take overlapped, as tega mvs does, and print the seconds per frame.");
   app.add_option("--device", device, "cpu or cuda.");
   app.add_option("--threads", threads, "CPU threads (0 = all).");
   app.add_option("--capture", capture, "Where the rendered capture is kept between runs (suffixed with its size).");
@@ -147,7 +186,7 @@ int main(int argc, char** argv) {
 
   const fs::path root = render_capture(capture + "-" + std::to_string(cameras) + "-" + std::to_string(width) + "x" +
                                            std::to_string(height),
-                                       cameras, width, height);
+                                       cameras, width, height, std::max({2, frame + 1, take_frames}));
   ThreadPool pool(threads);
   const Rig rig = read_rig_json(root / "rig.json");
   const mvs::FrameLoader loader(read_take(root / "takes" / "expressions"), rig, (root / "rig.json").string());
@@ -197,39 +236,51 @@ int main(int argc, char** argv) {
     return 0;
   }
 #endif
-  auto start = Clock::now();
-  std::vector<mvs::StereoView> views = loader.load(frame, pool);
 #ifdef TEGA_BENCH_HAVE_MVS
   const mvs::FrameLoader plate_loader(read_take(root / "takes" / "clean_plate"), rig, (root / "rig.json").string());
   const auto plates = plate_loader.load(0, pool);
-  pool.parallel_for(0, int64_t(views.size()), [&](int64_t k) {
-    views[size_t(k)].mask = mvs::subject_mask(views[size_t(k)].colour, plates[size_t(k)].colour, options.mask);
-  });
   const char* mask_source = "clean plate";
 #else
-  mask_from_truth(views, root, rig, frame, pool);
   const char* mask_source = "true coverage";
 #endif
-  const double load_s = seconds_since(start);
+  // A frame's first half (views, masks, depth maps), then its second (fusion
+  // and surface): run one after the other for the split of one frame, and
+  // overlapped across the frames of the take as `tega mvs` runs them.
+  const mvs::Device depth_device = mvs::parse_device(device);
+  const auto prepare = [&](int f) {
+    PreparedFrame prepared;
+    auto start = Clock::now();
+    prepared.views = loader.load(f, pool);
+#ifdef TEGA_BENCH_HAVE_MVS
+    pool.parallel_for(0, int64_t(prepared.views.size()), [&](int64_t k) {
+      prepared.views[size_t(k)].mask =
+          mvs::subject_mask(prepared.views[size_t(k)].colour, plates[size_t(k)].colour, options.mask);
+    });
+#else
+    mask_from_truth(prepared.views, root, rig, f, pool);
+#endif
+    prepared.times.load_s = seconds_since(start);
+    const std::vector<mvs::ViewTask> tasks = view_tasks(prepared.views, pm);
+    start = Clock::now();
+    prepared.maps = mvs::estimate_depth_maps(prepared.views, tasks, pm, depth_device, &pool);
+    prepared.times.depth_s = seconds_since(start);
+    return prepared;
+  };
+  const auto finish = [&](PreparedFrame& prepared) {
+    std::vector<int> map_views(prepared.views.size());
+    std::iota(map_views.begin(), map_views.end(), 0);
+    auto start = Clock::now();
+    prepared.cloud = mvs::fuse_depth_maps(prepared.views, map_views, prepared.maps, fusion_options, &pool);
+    prepared.times.fusion_s = seconds_since(start);
+#ifdef TEGA_BENCH_HAVE_SURFACE
+    start = Clock::now();
+    prepared.mesh = mvs::reconstruct_surface(prepared.cloud, surface_options);
+    prepared.times.surface_s = seconds_since(start);
+#endif
+  };
 
-  std::vector<Camera> pinholes;
-  for (const auto& v : views) pinholes.push_back(v.camera);
-  const Eigen::Vector3d focus = *mvs::rig_focus_point(pinholes);
-  const auto sources = mvs::select_source_views(pinholes, focus, pm.source_views);
-  std::vector<mvs::ViewTask> tasks;
-  std::vector<int> map_views;
-  for (size_t k = 0; k < views.size(); ++k) {
-    const double centre = views[k].camera.world_to_camera.apply(focus).z();
-    tasks.push_back({int(k), sources[k], float(centre - 0.3), float(centre + 0.3)});
-    map_views.push_back(int(k));
-  }
-
-  start = Clock::now();
-  const auto maps = mvs::estimate_depth_maps(views, tasks, pm, mvs::parse_device(device), &pool);
-  const double depth_s = seconds_since(start);
-  start = Clock::now();
-  const mvs::OrientedPointCloud cloud = mvs::fuse_depth_maps(views, map_views, maps, fusion_options, &pool);
-  const double fusion_s = seconds_since(start);
+  PreparedFrame one = prepare(frame);
+  finish(one);
 
   // Depth maps against the true fine mesh.
   const Mesh fine_topology = read_obj(root / "ground_truth" / "head" / "fine_topology.obj");
@@ -237,8 +288,8 @@ int main(int argc, char** argv) {
   std::snprintf(name, sizeof name, "%06d.bin", frame);
   const Vertices fine = read_vertices_bin(root / "ground_truth" / "expressions" / "fine" / name);
   DepthScore score;
-  for (size_t k = 0; k < views.size(); ++k)
-    score_depth(maps[k], synth::render_depth(views[k].camera, fine, fine_topology.faces), score);
+  for (size_t k = 0; k < one.views.size(); ++k)
+    score_depth(one.maps[k], synth::render_depth(one.views[k].camera, fine, fine_topology.faces), score);
   std::sort(score.errors.begin(), score.errors.end());
   std::printf("mvs bench: %d cameras %dx%d, frame %d, depth on %s, %d threads, masks from the %s\n", cameras, width,
               height, frame, device.c_str(), pool.size(), mask_source);
@@ -248,25 +299,55 @@ int main(int argc, char** argv) {
               100.0 * score.within_1mm / std::max<int64_t>(1, score.covered_and_estimated),
               100.0 * score.within_2mm / std::max<int64_t>(1, score.covered_and_estimated),
               100.0 * score.covered_and_estimated / std::max<int64_t>(1, score.covered));
-  std::printf("fused cloud: %d points\n", cloud.size());
-
-  double surface_s = 0;
+  std::printf("fused cloud: %d points\n", one.cloud.size());
 #ifdef TEGA_BENCH_HAVE_SURFACE
-  start = Clock::now();
-  const Mesh mesh = mvs::reconstruct_surface(cloud, surface_options);
-  surface_s = seconds_since(start);
-  report_mesh(mesh, root, frame);
+  report_mesh(one.mesh, root, frame);
   if (!out.empty()) {
     fs::create_directories(out);
-    write_mesh(mesh, fs::path(out) / "mesh.ply");
+    write_mesh(one.mesh, fs::path(out) / "mesh.ply");
   }
 #endif
   if (!out.empty()) {
     fs::create_directories(out);
-    mvs::write_point_cloud_ply(cloud, fs::path(out) / "fused.ply");
+    mvs::write_point_cloud_ply(one.cloud, fs::path(out) / "fused.ply");
   }
-  std::printf("%-10s %8s\n", "stage", "seconds");
-  std::printf("%-10s %8.2f\n%-10s %8.2f\n%-10s %8.2f\n%-10s %8.2f\n%-10s %8.2f\n", "load", load_s, "depth", depth_s,
-              "fusion", fusion_s, "surface", surface_s, "total", load_s + depth_s + fusion_s + surface_s);
+  std::printf("one frame, stage by stage:\n%-10s %8s\n", "stage", "seconds");
+  print_times(one.times, "");
+  one = {};
+
+  if (take_frames < 2) return 0;
+  // The take: frame n + 1 loads and gets its depth maps while frame n is
+  // fused and meshed. Its rate is the time between frames finishing.
+  std::vector<FrameTimes> times(static_cast<size_t>(take_frames));
+  std::vector<double> finished_at(static_cast<size_t>(take_frames));
+  std::vector<Mesh> meshes(static_cast<size_t>(take_frames));
+  const auto take_start = Clock::now();
+  mvs::for_each_frame_overlapped(0, take_frames, prepare, [&](int f, PreparedFrame prepared) {
+    finish(prepared);
+    times[size_t(f)] = prepared.times;
+    meshes[size_t(f)] = std::move(prepared.mesh);
+    finished_at[size_t(f)] = seconds_since(take_start);
+  });
+  std::printf("take of %d frames, overlapped (each stage's seconds include the other half's use of the CPU):\n"
+              "%-10s %8s %8s %8s %8s %10s\n",
+              take_frames, "frame", "load", "depth", "fusion", "surface", "done at");
+  for (int f = 0; f < take_frames; ++f) {
+    const FrameTimes& t = times[size_t(f)];
+    std::printf("%-10d %8.2f %8.2f %8.2f %8.2f %10.2f\n", f, t.load_s, t.depth_s, t.fusion_s, t.surface_s,
+                finished_at[size_t(f)]);
+  }
+  std::printf("seconds per frame over the whole take: %.2f (%.2f s)\n", finished_at.back() / take_frames,
+              finished_at.back());
+  // Neither the first frame (nothing before it to overlap) nor the last
+  // (nothing after it beside its fusion) shows the rate of a long take.
+  if (take_frames >= 3)
+    std::printf("seconds per frame in the steady state (frames 1 to %d): %.2f\n", take_frames - 2,
+                (finished_at[size_t(take_frames - 2)] - finished_at.front()) / (take_frames - 2));
+#ifdef TEGA_BENCH_HAVE_SURFACE
+  for (int f = 0; f < take_frames; ++f) {
+    std::printf("frame %d ", f);
+    report_mesh(meshes[size_t(f)], root, f);
+  }
+#endif
   return 0;
 }
