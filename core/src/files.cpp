@@ -7,6 +7,7 @@
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <vector>
 
 #include "tega/core/error.h"
 
@@ -15,11 +16,14 @@ namespace fs = std::filesystem;
 
 namespace {
 
+constexpr const char* kTemporaryMark = ".tmp-";
+constexpr const char* kResumeKeyFile = ".resume-key";
+
 // Unique within this process and across processes writing the same directory.
 std::string temporary_suffix() {
   static std::atomic<uint64_t> counter{0};
   static const uint64_t salt = std::random_device{}();
-  return ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(salt % 100000) + "-" +
+  return kTemporaryMark + std::to_string(::getpid()) + "-" + std::to_string(salt % 100000) + "-" +
          std::to_string(counter++);
 }
 
@@ -74,8 +78,28 @@ StagedDirectory::StagedDirectory(fs::path final_path, bool replace_existing)
   fs::create_directories(staging_);
 }
 
+StagedDirectory::StagedDirectory(fs::path final_path, bool replace_existing, const std::string& resume_key)
+    : final_(std::move(final_path)), replace_existing_(replace_existing), resumable_(true) {
+  if (final_.filename().empty()) final_ = final_.parent_path();
+  if (fs::exists(final_) && !replace_existing_) {
+    throw Error(final_, "already exists (pass --force to replace it)");
+  }
+  staging_ = final_.string() + ".partial";
+  const fs::path key_file = staging_ / kResumeKeyFile;
+  if (fs::exists(key_file) && read_text_file(key_file) == resume_key) {
+    std::vector<fs::path> leftovers;
+    for (const auto& entry : fs::recursive_directory_iterator(staging_))
+      if (entry.path().filename().string().find(kTemporaryMark) != std::string::npos) leftovers.push_back(entry.path());
+    for (const auto& leftover : leftovers) remove_tree(leftover);
+  } else {
+    remove_tree(staging_);
+    fs::create_directories(staging_);
+    write_text_atomic(key_file, resume_key);
+  }
+}
+
 StagedDirectory::~StagedDirectory() {
-  if (committed_) return;
+  if (committed_ || resumable_) return;
   try {
     remove_tree(staging_);
   } catch (const Error&) {
@@ -86,6 +110,7 @@ StagedDirectory::~StagedDirectory() {
 void StagedDirectory::commit() {
   // rename() cannot replace a non-empty directory, so the old one is moved
   // aside first and removed only once the new one is in place.
+  if (resumable_) fs::remove(staging_ / kResumeKeyFile);
   fs::path old;
   if (fs::exists(final_)) {
     if (!replace_existing_) throw Error(final_, "appeared while it was being written");

@@ -91,4 +91,21 @@ TEST_F(DatasetTest, NotADatasetIsNamed) {
   }
 }
 
+TEST(DatasetSampling, FramesAreTheMiddlesOfEqualParts) {
+  EXPECT_EQ(tega::evenly_spaced_indices(6, 4), (std::vector<size_t>{0, 2, 3, 5}));
+  EXPECT_EQ(tega::evenly_spaced_indices(400, 2), (std::vector<size_t>{100, 300}));
+  EXPECT_EQ(tega::evenly_spaced_indices(3, 0), (std::vector<size_t>{0, 1, 2}));  // 0: all
+  EXPECT_EQ(tega::evenly_spaced_indices(3, 5), (std::vector<size_t>{0, 1, 2}));
+  EXPECT_TRUE(tega::evenly_spaced_indices(0, 4).empty());
+}
+
+TEST(DatasetSampling, TestCamerasAreSpreadOverTheRig) {
+  tega::Rig rig;
+  for (const char* name : {"c0", "c1", "c2", "c3", "c4", "c5"}) rig.cameras.push_back({name});
+  EXPECT_EQ(tega::spread_test_cameras(rig, 2), (std::vector<std::string>{"c5", "c2"}));
+  EXPECT_EQ(tega::spread_test_cameras(rig, 9), (std::vector<std::string>{"c5", "c4", "c3", "c2", "c1"}));
+  rig.cameras.resize(1);
+  EXPECT_EQ(tega::spread_test_cameras(rig, 2), (std::vector<std::string>{"c0"}));
+}
+
 }  // namespace

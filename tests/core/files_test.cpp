@@ -74,6 +74,32 @@ TEST(Files, StagedDirectoryRefusesOrReplacesExisting) {
   EXPECT_EQ(entries_in(tmp.path()), 1u);
 }
 
+TEST(Files, ResumableStagedDirectoryKeepsWhatARunWithTheSameKeyWrote) {
+  tega::test::TempDir tmp;
+  const auto out = tmp / "dataset";
+  {
+    tega::StagedDirectory interrupted(out, false, "key 1");
+    EXPECT_EQ(interrupted.path(), tmp / "dataset.partial");
+    tega::write_text_atomic(interrupted.path() / "images/a.png", "a");
+    tega::test::write_text(interrupted.path() / "images/b.png.tmp-1-2-3", "half written");
+  }  // not committed: kept for the next run
+  {
+    tega::StagedDirectory resumed(out, false, "key 1");
+    EXPECT_EQ(tega::read_text_file(resumed.path() / "images/a.png"), "a");
+    EXPECT_FALSE(fs::exists(resumed.path() / "images/b.png.tmp-1-2-3"));
+  }
+  {
+    tega::StagedDirectory changed(out, false, "key 2");
+    EXPECT_FALSE(fs::exists(changed.path() / "images/a.png"));
+    tega::write_text_atomic(changed.path() / "c.png", "c");
+    changed.commit();
+  }
+  EXPECT_EQ(tega::read_text_file(out / "c.png"), "c");
+  EXPECT_EQ(entries_in(out), 1u);  // no resume key in the output
+  EXPECT_EQ(entries_in(tmp.path()), 1u);
+  EXPECT_THROW(tega::StagedDirectory(out, false, "key 2"), tega::Error);
+}
+
 TEST(Files, RemoveTreeRemovesNestedDirectoriesAndToleratesMissingPaths) {
   tega::test::TempDir tmp;
   tega::write_text_atomic(tmp / "tree/a/b/c.txt", "c");

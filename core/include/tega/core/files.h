@@ -28,9 +28,17 @@ void write_text_atomic(const std::filesystem::path& file, std::string_view text)
 // name by commit(). Uncommitted, it is removed on destruction. An existing
 // final directory is replaced only when `replace_existing`; otherwise the
 // constructor throws tega::Error naming it.
+//
+// Resumable (given a `resume_key`): the staging directory has a fixed name,
+// <final>.partial, and outlives a failed or killed run, so that a long stage
+// run again with the same key (its options and inputs) keeps what it had
+// written; with another key it starts empty. Whatever the stage wrote there
+// must itself be atomic (write_file_atomic): temporaries a killed run left
+// are removed.
 class StagedDirectory {
  public:
   StagedDirectory(std::filesystem::path final_path, bool replace_existing);
+  StagedDirectory(std::filesystem::path final_path, bool replace_existing, const std::string& resume_key);
   ~StagedDirectory();
   StagedDirectory(const StagedDirectory&) = delete;
   StagedDirectory& operator=(const StagedDirectory&) = delete;
@@ -41,7 +49,7 @@ class StagedDirectory {
 
  private:
   std::filesystem::path final_, staging_;
-  bool replace_existing_, committed_ = false;
+  bool replace_existing_, resumable_ = false, committed_ = false;
 };
 
 }  // namespace tega
