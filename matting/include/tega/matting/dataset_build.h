@@ -1,0 +1,70 @@
+#pragma once
+// `tega dataset build`: the trainer's dataset (docs/layouts.md#dataset) from a
+// capture, what `tega track` made of it and what `tega matte` made of it
+// (docs/matting.md#building-the-dataset). Each image is undistorted to the
+// rig's pinhole, downsampled by area and written as RGBA with its matte as
+// alpha; the frames are sampled uniformly over the performance takes.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace tega::matting {
+
+struct DatasetBuildOptions {
+  int downsample = 2;
+  int frames = 400;
+  std::vector<std::string> test_takes;
+  std::vector<std::string> test_cameras;
+  int test_camera_count = 2;
+  int png_compression = 1;
+  int threads = 0;
+
+  template <class V>
+  void visit(V& v) {
+    v("downsample", downsample,
+      "Integer factor the images are shrunk by (area averaging after undistortion); it must divide every "
+      "camera's size. The paper trains on 3072 x 2048, half its 6144 x 4096 captures.");
+    v("frames", frames,
+      "Frames in the dataset, sampled uniformly over every performance take's tracked frames in take order "
+      "(the paper: 400); 0 = all of them.");
+    v("test_takes", test_takes,
+      "Performance takes whose sampled frames form the test split (reenactment); empty = the last performance "
+      "take when there are two or more, none otherwise.");
+    v("test_cameras", test_cameras,
+      "Cameras held out for the test split (novel views), by name; empty = test_camera_count cameras spread "
+      "over the rig.");
+    v("test_camera_count", test_camera_count,
+      "Held-out cameras when test_cameras is empty (clamped to 1 .. cameras - 1).");
+    v("png_compression", png_compression,
+      "zlib level of the images (0-9): 1 writes several times faster than 6 for files about 10% larger "
+      "(docs/matting.md#storage).");
+    v("threads", threads, "Worker threads; 0 = one per hardware thread.");
+  }
+};
+
+struct DatasetBuildRequest {
+  std::filesystem::path capture;  // CAPTURE/: capture.json, rig.json, takes/
+  std::filesystem::path tracked;  // TRACKED/ from tega track
+  std::filesystem::path mattes;   // MATTES/ from tega matte: <take>/<camera>/<frame:06d>.png, <take>/mattes.json
+  std::filesystem::path out;      // DATASET/
+  std::filesystem::path rig;      // empty: the capture's rig file
+  bool replace_existing = false;  // an existing DATASET/ is an error otherwise
+};
+
+struct DatasetBuildSummary {
+  std::filesystem::path dataset;
+  int train_frames = 0, test_frames = 0;
+  std::vector<std::string> train_cameras, test_cameras;
+  int images = 0;       // in the dataset
+  int images_kept = 0;  // of them, written by an interrupted run with the same options and inputs
+};
+
+// Throws tega::Error naming the file for bad input: a missing or damaged
+// capture, rig, tracked take, mesh, image or matte; a matte or image whose size
+// is not the camera's; options the capture cannot satisfy. An interrupted run
+// leaves DATASET.partial/, which a run with the same options and inputs
+// continues.
+DatasetBuildSummary build_dataset(const DatasetBuildRequest& request, const DatasetBuildOptions& options);
+
+}  // namespace tega::matting

@@ -1,0 +1,267 @@
+#include "tega/matting/dataset_build.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+
+#include "dataset_image.h"
+#include "recorded_image.h"
+#include "tega/core/dataset.h"
+#include "tega/core/error.h"
+#include "tega/core/files.h"
+#include "tega/core/image_header.h"
+#include "tega/core/options.h"
+#include "tega/core/progress.h"
+#include "tega/core/rig.h"
+#include "tega/core/take.h"
+#include "tega/core/thread_pool.h"
+#include "tega/core/undistort.h"
+#include "tega/tracking/tracked.h"
+
+namespace tega::matting {
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kMattesDone = "mattes.json";
+
+void check_options(const DatasetBuildOptions& o) {
+  const auto fail = [](const std::string& what) { throw Error("dataset build options: " + what); };
+  if (o.downsample < 1) fail("downsample must be 1 or more");
+  if (o.frames < 0) fail("frames must be 0 (all) or positive");
+  if (o.test_camera_count < 1) fail("test_camera_count must be 1 or more");
+  if (o.png_compression < 0 || o.png_compression > 9) fail("png_compression must be in 0 .. 9");
+}
+
+bool contains(const std::vector<std::string>& names, const std::string& name) {
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+std::string frame_name(int frame) {
+  char name[16];
+  std::snprintf(name, sizeof name, "%06d", frame);
+  return name;
+}
+
+// A tracked frame the dataset may take: every camera recorded it.
+struct Candidate {
+  const TakeInfo* take;
+  tracking::TrackedFrame tracked;
+  std::string id() const { return take->name + "_" + frame_name(tracked.frame); }
+};
+
+fs::path matte_path(const fs::path& mattes, const Candidate& frame, const std::string& camera) {
+  return mattes / frame.take->name / camera / (frame_name(frame.tracked.frame) + ".png");
+}
+
+std::string view_name(const Candidate& frame, const std::string& camera) {
+  return "camera " + camera + ", frame " + frame.id();
+}
+
+struct Inputs {
+  CaptureInfo capture;
+  fs::path rig_file;
+  Rig rig;  // the capture's cameras, in the rig's order, with their distortion
+  std::vector<TakeInfo> takes;
+  tracking::TrackedSubject subject;
+  std::vector<Candidate> candidates;
+  std::string fingerprint;  // what the images depend on besides the options: the resume key
+};
+
+// The cameras the capture records, as the rig has them; each must divide by the factor.
+Rig capture_rig(const CaptureInfo& capture, const fs::path& rig_file, int downsample) {
+  const Rig full = read_rig_json(rig_file);
+  Rig rig;
+  for (const Camera& camera : full.cameras)
+    if (contains(capture.cameras, camera.name)) rig.cameras.push_back(camera);
+  for (const auto& name : capture.cameras)
+    if (!full.contains(name)) throw Error(rig_file, "has no camera " + name + ", which the capture records");
+  for (const Camera& camera : rig.cameras)
+    if (camera.width % downsample != 0 || camera.height % downsample != 0)
+      throw Error(rig_file, "camera " + camera.name + " is " + std::to_string(camera.width) + "x" +
+                                std::to_string(camera.height) + ", which downsample " + std::to_string(downsample) +
+                                " does not divide");
+  return rig;
+}
+
+// Triangles of the template whose three corners are eyeball vertices.
+std::vector<int32_t> eyeball_faces(const Mesh& mesh, const std::vector<int>& eyeball_vertices) {
+  std::vector<bool> on_eyeball(static_cast<size_t>(mesh.num_vertices()), false);
+  for (const int v : eyeball_vertices) on_eyeball[static_cast<size_t>(v)] = true;
+  std::vector<int32_t> faces;
+  for (Eigen::Index f = 0; f < mesh.faces.rows(); ++f)
+    if (on_eyeball[mesh.faces(f, 0)] && on_eyeball[mesh.faces(f, 1)] && on_eyeball[mesh.faces(f, 2)])
+      faces.push_back(static_cast<int32_t>(f));
+  return faces;
+}
+
+Inputs read_inputs(const DatasetBuildRequest& request, const DatasetBuildOptions& options) {
+  Inputs in;
+  in.capture = read_capture(request.capture);
+  in.rig_file = in.capture.rig_file(request.rig);
+  in.rig = capture_rig(in.capture, in.rig_file, options.downsample);
+  in.subject = tracking::read_tracked_subject(request.tracked);
+  if (!in.subject.neutral.has_uvs())
+    throw Error(request.tracked / "identity.json", "names a neutral mesh without UVs; the dataset's template needs them");
+
+  in.fingerprint = "capture: " + fs::absolute(request.capture).string() + "\nrig: " + read_text_file(in.rig_file) +
+                   "\ntracked: " + fs::absolute(request.tracked).string() +
+                   "\nmattes: " + fs::absolute(request.mattes).string() + "\n";
+  const std::vector<std::string> names = in.capture.performance_takes({}, "to build a dataset from");
+  in.takes.reserve(names.size());  // candidates point into it
+  int incomplete = 0;
+  for (const auto& name : names) {
+    const TakeInfo& take = in.takes.emplace_back(read_take(in.capture.root / "takes" / name));
+    const fs::path mattes_done = request.mattes / name / kMattesDone;
+    if (!fs::exists(mattes_done))
+      throw Error(mattes_done, "is missing: take " + name + " was not matted to its end (run tega matte)");
+    std::vector<tracking::TrackedFrame> tracked = tracking::read_tracked_take(request.tracked, name);
+    in.fingerprint += name + " mattes: " + read_text_file(mattes_done) + "\n" + name +
+                      " tracked: " + read_text_file(request.tracked / name / "track.json") + "\n";
+    for (auto& frame : tracked) {
+      if (!frame.tracked()) continue;
+      if (frame.frame < 0 || frame.frame >= take.frames)
+        throw Error(frame.mesh, "is tracked frame " + std::to_string(frame.frame) + " of take " + name + ", which has " +
+                                    std::to_string(take.frames) + " frames");
+      const bool recorded = std::all_of(in.rig.cameras.begin(), in.rig.cameras.end(),
+                                        [&](const Camera& c) { return take.has_image(c.name, frame.frame); });
+      if (recorded) in.candidates.push_back({&take, std::move(frame)});
+      else ++incomplete;
+    }
+  }
+  if (incomplete > 0)
+    spdlog::warn("dataset build: {} tracked frame(s) left out: a camera has no image of them (take.json: missing)",
+                 incomplete);
+  if (in.candidates.empty())
+    throw Error(request.tracked, "has no tracked frame that every camera recorded: nothing to build a dataset from");
+  return in;
+}
+
+std::vector<std::string> held_out_takes(const Inputs& in, const DatasetBuildOptions& options) {
+  std::vector<std::string> performance;
+  for (const auto& take : in.takes) performance.push_back(take.name);
+  for (const auto& name : options.test_takes)
+    if (!contains(performance, name))
+      throw Error(in.capture.root / "capture.json", "has no performance take '" + name + "' (named in test_takes)");
+  if (!options.test_takes.empty()) return options.test_takes;
+  if (performance.size() < 2) return {};
+  return {performance.back()};
+}
+
+void choose_cameras(Dataset& dataset, const Inputs& in, const DatasetBuildOptions& options) {
+  for (const auto& name : options.test_cameras)
+    if (!in.rig.contains(name))
+      throw Error(in.rig_file, "has no camera '" + name + "' of the capture (named in test_cameras)");
+  dataset.test.cameras =
+      options.test_cameras.empty() ? spread_test_cameras(in.rig, options.test_camera_count) : options.test_cameras;
+  for (const Camera& camera : in.rig.cameras)
+    if (!contains(dataset.test.cameras, camera.name) || in.rig.cameras.size() == 1)
+      dataset.train.cameras.push_back(camera.name);
+  if (dataset.train.cameras.empty()) throw Error(in.rig_file, "test_cameras hold out every camera; none is left to train on");
+}
+
+// Everything that can be checked cheaply, before the heavy work: each image
+// and matte exists, and the mattes have the captured size.
+void check_views(const std::vector<const Candidate*>& frames, const Inputs& in, const fs::path& mattes,
+                 ThreadPool& pool) {
+  const size_t n = in.rig.cameras.size();
+  pool.parallel_for(0, static_cast<int64_t>(frames.size() * n), [&](int64_t i) {
+    const Candidate& f = *frames[static_cast<size_t>(i) / n];
+    const Camera& camera = in.rig.cameras[static_cast<size_t>(i) % n];
+    const fs::path image = f.take->image_path(camera.name, f.tracked.frame);
+    if (!fs::exists(image)) throw Error(image, "is missing (" + view_name(f, camera.name) + ")");
+    const fs::path matte = matte_path(mattes, f, camera.name);
+    if (!fs::exists(matte)) throw Error(matte, "is missing (the matte of " + view_name(f, camera.name) + "; run tega matte)");
+    check_matte(matte, read_image_header(matte), camera.width, camera.height);
+  });
+}
+
+}  // namespace
+
+DatasetBuildSummary build_dataset(const DatasetBuildRequest& request, const DatasetBuildOptions& options) {
+  check_options(options);
+  const Inputs in = read_inputs(request, options);
+
+  const std::vector<std::string> test_takes = held_out_takes(in, options);
+  std::vector<const Candidate*> frames;
+  for (const size_t i : evenly_spaced_indices(in.candidates.size(), options.frames))
+    frames.push_back(&in.candidates[i]);
+
+  ThreadPool pool(options.threads);
+  check_views(frames, in, request.mattes, pool);
+
+  DatasetBuildOptions resume_options = options;
+  resume_options.threads = 0;  // the output does not depend on it
+  StagedDirectory staged(request.out, request.replace_existing, options_to_yaml(resume_options) + in.fingerprint);
+  Dataset dataset;
+  dataset.root = staged.path();
+  dataset.template_mesh = in.subject.neutral;
+  dataset.eyeball_faces = eyeball_faces(in.subject.neutral, in.subject.eyeball_vertices);
+  dataset.landmark_vertices.assign(in.subject.landmark_vertices.begin(), in.subject.landmark_vertices.end());
+  for (const Camera& camera : in.rig.cameras)
+    dataset.rig.cameras.push_back(without_distortion(camera).scaled(1.0 / options.downsample));
+  choose_cameras(dataset, in, options);
+  for (const Candidate* f : frames) {
+    dataset.frames.push_back({f->id(), f->take->name, f->tracked.head_to_world});
+    (contains(test_takes, f->take->name) ? dataset.test : dataset.train).frames.push_back(f->id());
+  }
+
+  const int vertices = dataset.template_mesh.num_vertices();
+  fs::create_directories(dataset.mesh_path("x").parent_path());
+  pool.parallel_for(0, static_cast<int64_t>(frames.size()), [&](int64_t i) {
+    const Candidate& f = *frames[static_cast<size_t>(i)];
+    const fs::path target = dataset.mesh_path(f.id());
+    if (!fs::exists(target)) write_vertices_bin(read_vertices_bin(f.tracked.mesh, vertices), target);
+  });
+
+  const int64_t total = static_cast<int64_t>(frames.size() * in.rig.cameras.size());
+  Progress progress("dataset build", total, "images");
+  int kept = 0;
+  for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
+    const Camera& captured = in.rig.cameras[c];
+    const std::string& camera = captured.name;
+    fs::create_directories(dataset.image_path(camera, "x").parent_path());
+    std::vector<const Candidate*> to_write;
+    for (const Candidate* f : frames) {
+      if (fs::exists(dataset.image_path(camera, f->id()))) {
+        ++kept;
+        progress.advance();
+      } else {
+        to_write.push_back(f);
+      }
+    }
+    if (to_write.empty()) continue;
+    // Once per camera: at 6144 x 4096 the maps take 200 MB and a second to make.
+    const std::unique_ptr<UndistortionMaps> maps =
+        captured.has_distortion() ? std::make_unique<UndistortionMaps>(captured.undistortion_maps()) : nullptr;
+    pool.parallel_for(0, static_cast<int64_t>(to_write.size()), [&](int64_t i) {
+      const Candidate& f = *to_write[static_cast<size_t>(i)];
+      const Image8 rgb = read_recorded_rgb(*f.take, camera, f.tracked.frame, captured.width, captured.height);
+      const Image8 matte =
+          read_matte(matte_path(request.mattes, f, camera), captured.width, captured.height, view_name(f, camera));
+      const Image8 rgba = dataset_rgba(rgb, matte, maps.get(), options.downsample);
+      write_png_view({rgba.pixels.data(), rgba.width, rgba.height, 4, 8, static_cast<size_t>(rgba.width) * 4},
+                     dataset.image_path(camera, f.id()), options.png_compression);
+      progress.advance();
+    });
+  }
+  progress.finish();
+
+  write_dataset_manifest(dataset);
+  validate_dataset(read_dataset(staged.path()));
+  staged.commit();
+
+  DatasetBuildSummary summary;
+  summary.dataset = staged.final_path();
+  summary.train_frames = static_cast<int>(dataset.train.frames.size());
+  summary.test_frames = static_cast<int>(dataset.test.frames.size());
+  summary.train_cameras = dataset.train.cameras;
+  summary.test_cameras = dataset.test.cameras;
+  summary.images = static_cast<int>(total);
+  summary.images_kept = kept;
+  return summary;
+}
+
+}  // namespace tega::matting
