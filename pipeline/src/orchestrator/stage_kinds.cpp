@@ -13,18 +13,6 @@ std::vector<std::string> with_flags(std::vector<std::string> arguments, const Sh
   return arguments;
 }
 
-// A stage of the capture chain that tega does not implement yet: declared so
-// that capture-based configs describe their whole graph and report it honestly.
-StageKind not_implemented(std::string name, std::string summary, std::vector<std::string> needs,
-                          std::map<std::string, std::string> provides) {
-  StageKind kind;
-  kind.name = std::move(name);
-  kind.summary = std::move(summary);
-  kind.needs = std::move(needs);
-  kind.provides = std::move(provides);
-  return kind;
-}
-
 std::vector<StageKind> make_stage_kinds() {
   std::vector<StageKind> kinds;
 
@@ -181,8 +169,37 @@ std::vector<StageKind> make_stage_kinds() {
                        p);
   };
   kinds.push_back(track);
-  kinds.push_back(not_implemented("matting", "mattes and downsamples the images into a dataset",
-                                  {"capture", "rig", "tracked"}, {{"dataset", "dataset"}}));
+  // Alpha mattes of every performance image, in the captured image space.
+  StageKind matte;
+  matte.name = "matte";
+  matte.summary = "mattes every image of the performance takes (tega matte)";
+  matte.subcommand = {"matte"};
+  matte.needs = {"capture", "rig", "tracked"};
+  matte.provides = {{"mattes", "mattes"}};
+  matte.options_section = "matte";
+  matte.arguments = [](const ShardPaths& p) {
+    return with_config({"--capture", p.artifacts.at("capture").string(), "--rig", p.artifacts.at("rig").string(),
+                        "--tracked", p.artifacts.at("tracked").string(), "--out", (p.output / "mattes").string()},
+                       p);
+  };
+  kinds.push_back(matte);
+  // The trainer's dataset: sampled frames, undistorted and downsampled RGBA
+  // images; resumes from the images an interrupted shard wrote.
+  StageKind dataset;
+  dataset.name = "dataset";
+  dataset.summary = "assembles the dataset from the capture, its tracked meshes and mattes (tega dataset build)";
+  dataset.subcommand = {"dataset", "build"};
+  dataset.needs = {"capture", "rig", "tracked", "mattes"};
+  dataset.provides = {{"dataset", "dataset"}};
+  dataset.options_section = "dataset";
+  dataset.resumes_in_staging = true;
+  dataset.arguments = [](const ShardPaths& p) {
+    return with_config({"--capture", p.artifacts.at("capture").string(), "--rig", p.artifacts.at("rig").string(),
+                        "--tracked", p.artifacts.at("tracked").string(), "--mattes",
+                        p.artifacts.at("mattes").string(), "--out", (p.output / "dataset").string()},
+                       p);
+  };
+  kinds.push_back(dataset);
   return kinds;
 }
 
