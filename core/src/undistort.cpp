@@ -1,7 +1,6 @@
 #include "tega/core/undistort.h"
 
 #include <algorithm>
-#include <cmath>
 #include <string>
 
 #include "tega/core/error.h"
@@ -27,7 +26,11 @@ Image8 undistort_image(const Image8& captured, const UndistortionMaps& maps) {
   if (captured.width != maps.width || captured.height != maps.height)
     throw Error("undistort: the image and the undistortion maps differ in size");
   const int w = captured.width, h = captured.height, channels = captured.channels;
+  const size_t row = static_cast<size_t>(w) * channels;
   Image8 out(w, h, channels, 0);
+  // Datasets undistort 26-megapixel images: the loop works on raw pointers
+  // and rounds by truncating value + 0.5 (values are never negative), which
+  // lround would do four times slower.
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
       const size_t i = static_cast<size_t>(v) * w + u;
@@ -39,12 +42,15 @@ Image8 undistort_image(const Image8& captured, const UndistortionMaps& maps) {
       const float cx = std::clamp(x, 0.0f, static_cast<float>(w - 1));
       const float cy = std::clamp(y, 0.0f, static_cast<float>(h - 1));
       const int x0 = std::min(static_cast<int>(cx), w - 1), y0 = std::min(static_cast<int>(cy), h - 1);
-      const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
       const float fx = cx - x0, fy = cy - y0;
+      const uint8_t* top = captured.pixels.data() + static_cast<size_t>(y0) * row + static_cast<size_t>(x0) * channels;
+      const uint8_t* bottom = y0 + 1 < h ? top + row : top;
+      const int right = x0 + 1 < w ? channels : 0;
+      uint8_t* pixel = out.pixels.data() + i * channels;
       for (int c = 0; c < channels; ++c) {
-        const float top = (1 - fx) * captured.at(x0, y0, c) + fx * captured.at(x1, y0, c);
-        const float bottom = (1 - fx) * captured.at(x0, y1, c) + fx * captured.at(x1, y1, c);
-        out.at(u, v, c) = static_cast<uint8_t>(std::lround((1 - fy) * top + fy * bottom));
+        const float upper = top[c] + fx * (top[c + right] - top[c]);
+        const float lower = bottom[c] + fx * (bottom[c + right] - bottom[c]);
+        pixel[c] = static_cast<uint8_t>(upper + fy * (lower - upper) + 0.5f);
       }
     }
   }
