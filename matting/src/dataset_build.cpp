@@ -192,11 +192,7 @@ DatasetBuildSummary build_dataset(const DatasetBuildRequest& request, const Data
   ThreadPool pool(options.threads);
   check_views(frames, in, request.mattes, pool);
 
-  DatasetBuildOptions resume_options = options;
-  resume_options.threads = 0;  // the output does not depend on it
-  StagedDirectory staged(request.out, request.replace_existing, options_to_yaml(resume_options) + in.fingerprint);
   Dataset dataset;
-  dataset.root = staged.path();
   dataset.template_mesh = in.subject.neutral;
   dataset.eyeball_faces = eyeball_faces(in.subject.neutral, in.subject.eyeball_vertices);
   dataset.landmark_vertices.assign(in.subject.landmark_vertices.begin(), in.subject.landmark_vertices.end());
@@ -207,6 +203,11 @@ DatasetBuildSummary build_dataset(const DatasetBuildRequest& request, const Data
     dataset.frames.push_back({f->id(), f->take->name, f->tracked.head_to_world});
     (contains(test_takes, f->take->name) ? dataset.test : dataset.train).frames.push_back(f->id());
   }
+
+  DatasetBuildOptions resume_options = options;
+  resume_options.threads = 0;  // the output does not depend on it
+  StagedDirectory staged(request.out, request.replace_existing, options_to_yaml(resume_options) + in.fingerprint);
+  dataset.root = staged.path();
 
   const int vertices = dataset.template_mesh.num_vertices();
   fs::create_directories(dataset.mesh_path("x").parent_path());

@@ -267,6 +267,10 @@ TEST_F(DatasetBuild, BadInputIsAnErrorNamingTheFile) {
   options.test_takes = {"nope"};
   EXPECT_NE(error_of([&] { build(options, "g"); }).find("capture.json: has no performance take 'nope'"),
             std::string::npos);
+  options = {};
+  options.test_cameras = {"cam99"};
+  EXPECT_NE(error_of([&] { build(options, "h"); }).find("rig.json: has no camera 'cam99'"), std::string::npos);
+  EXPECT_FALSE(fs::exists(out_ / "h.partial"));  // bad input is found before anything is written
 }
 
 TEST_F(DatasetBuild, OnTheCommandLine) {
