@@ -161,14 +161,23 @@ TEST(StudioTracking, TracksTegasOwnMeshesWithinTheTargets) {
   const auto flowed = nlohmann::json::parse(read_text_file(dir / "tracked_on_truth" / "expressions" / "000004.json"));
   EXPECT_GT(flowed["residuals"]["flow_points"].get<int>(), 1000);
   EXPECT_LT(flowed["residuals"]["flow_rms_px"].get<double>(), 5.0);
-  reuse.flow.enabled = false;
 
   // A frame without a scan is recorded and skipped; its neighbours are
-  // tracked (the next one starting afresh when the gap is too wide).
+  // tracked (the next one starting afresh when the gap is too wide). The run
+  // resumes the one above after frame 4, so only frames 5-7 are redone.
+  fs::copy(dir / "tracked_on_truth", dir / "tracked_with_gap", fs::copy_options::recursive);
+  for (int frame = 5; frame < kFrames; ++frame) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%06d", frame);
+    fs::remove(dir / "tracked_with_gap" / "expressions" / (std::string(name) + ".json"));
+    fs::remove(dir / "tracked_with_gap" / "expressions" / (std::string(name) + ".bin"));
+  }
+  fs::remove(dir / "tracked_with_gap" / "expressions" / "track.json");
   fs::remove(dir / "true_meshes" / "expressions" / "000005.ply");
   const TrackSummary gap = track_capture({capture, {}, dir / "true_meshes", dir / "tracked_with_gap", {}}, reuse);
+  EXPECT_EQ(gap.frames_kept, 5);
   EXPECT_EQ(gap.frames_skipped, 1);
-  EXPECT_EQ(gap.frames_tracked, kFrames - 1);
+  EXPECT_EQ(gap.frames_tracked, kFrames - 6);
   const auto skipped = nlohmann::json::parse(read_text_file(dir / "tracked_with_gap" / "expressions" / "000005.json"));
   EXPECT_EQ(skipped["status"], "skipped");
   EXPECT_NE(skipped["reason"].get<std::string>().find("000005.ply"), std::string::npos);
