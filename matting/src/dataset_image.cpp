@@ -32,8 +32,7 @@ Image8 dataset_rgba(const Image8& rgb, const Image8& matte, const UndistortionMa
     for (int c = 0; c < 3; ++c) rgba.pixels[4 * i + c] = rgb.pixels[3 * i + c];
     rgba.pixels[4 * i + 3] = matte.pixels[i];
   }
-  if (maps) rgba = undistort_image(rgba, *maps);
-  return box_downsample(rgba, downsample);
+  return maps ? undistort_image(rgba, *maps, downsample) : box_downsample(rgba, downsample);
 }
 
 }  // namespace tega::matting

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "tega/core/downsample.h"
 #include "tega/core/error.h"
 
 namespace tega {
@@ -88,6 +89,19 @@ TEST(Undistort, MatchesThePinholeRenderingOfTheSameScene) {
   EXPECT_LT(mean_difference(undistorted, pinhole, inside), 2.5);
   // The check has teeth: the captured image itself is far from the pinhole's.
   EXPECT_GT(mean_difference(captured, pinhole, inside), 20.0);
+}
+
+TEST(Undistort, InOnePassWithDownsamplingEqualsTheTwoSteps) {
+  const Camera camera = distorted_camera();
+  const Image8 captured = render(camera);
+  const UndistortionMaps maps = camera.undistortion_maps();
+  for (const int factor : {1, 2, 4}) {
+    const Image8 one_pass = undistort_image(captured, maps, factor);
+    const Image8 two_steps = box_downsample(undistort_image(captured, maps), factor);
+    EXPECT_EQ(one_pass.width, two_steps.width);
+    EXPECT_EQ(one_pass.pixels, two_steps.pixels) << "factor " << factor;
+  }
+  EXPECT_THROW(undistort_image(captured, maps, 7), Error);
 }
 
 TEST(Undistort, APointLandsWherePinholeProjectionPutsIt) {

@@ -23,4 +23,11 @@ Image8 undistort_image(const Image8& captured, const Camera& camera);
 // Same with the camera's maps computed once, for the many images of one camera.
 Image8 undistort_image(const Image8& captured, const UndistortionMaps& maps);
 
+// Undistorted and shrunk by `factor` in one pass: exactly
+// box_downsample(undistort_image(captured, maps), factor) (downsample.h),
+// without the full-size intermediate, which at 26 megapixels costs more to
+// write and read back than to compute. Throws tega::Error unless factor
+// divides both sides.
+Image8 undistort_image(const Image8& captured, const UndistortionMaps& maps, int factor);
+
 }  // namespace tega
