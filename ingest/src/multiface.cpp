@@ -194,9 +194,9 @@ IngestSummary ingest_multiface(const fs::path& capture_root, const fs::path& out
       const fs::path source = capture.image(output_camera.name, frames[f]);
       const Image8 read = read_image_u8(source);
       check_image_size({read.width, read.height, read.channels, 8}, source, options);
-      Image8 rgb = rgb_of(read, source);
-      if (captured_camera.has_distortion()) rgb = undistort_image(rgb, maps);
-      rgb = box_downsample(rgb, options.downsample);
+      const Image8 captured = rgb_of(read, source);
+      const Image8 rgb = captured_camera.has_distortion() ? undistort_image(captured, maps, options.downsample)
+                                                          : box_downsample(captured, options.downsample);
 
       Image8 alpha(rgb.width, rgb.height, 1, 255);
       if (options.matte == "mesh") {
