@@ -6,6 +6,7 @@
 #include "commands.h"
 #include "tega/core/error.h"
 #include "tega/core/options.h"
+#include "tega/tracking/evaluation.h"
 #include "tega/tracking/tracking.h"
 
 namespace tega::cli {
@@ -17,6 +18,7 @@ struct TrackArguments {
   std::vector<std::string> takes, overrides;
   int threads = -1;
   bool print_options = false;
+  bool studio_truth = false;
 };
 
 // Defaults, then the --config file's `track` section, then --set, then the flags given.
@@ -56,12 +58,21 @@ void add_track_command(CLI::App& app) {
   cmd->add_option("--config", args->config, "YAML file whose `track` section sets options (see --print-options).");
   cmd->add_option("--set", args->overrides, "Override one option, e.g. --set icp_iterations=6 (repeatable).");
   cmd->add_flag("--print-options", args->print_options, "Print every track option with its default and exit.");
+  cmd->add_flag("--studio-truth", args->studio_truth,
+                "Track nothing: write a virtual-studio capture's ground truth (its template, true meshes and poses) "
+                "in the tracked layout, to run the later stages apart from tracking's error.");
   cmd->callback([args] {
     const tracking::Options options = options_of(*args);
     if (args->print_options) {
       std::cout << "track:\n";
       std::istringstream yaml(options_to_yaml(options));
       for (std::string line; std::getline(yaml, line);) std::cout << "  " << line << "\n";
+      return;
+    }
+    if (args->studio_truth) {
+      if (args->capture.empty() || args->out.empty()) throw Error("tega track --studio-truth: --capture and --out are required");
+      tracking::write_studio_truth_as_tracked(args->capture, args->out, args->takes);
+      std::printf("%s: the studio's ground truth in the tracked layout\n", args->out.c_str());
       return;
     }
     if (args->capture.empty() || args->meshes.empty() || args->out.empty())

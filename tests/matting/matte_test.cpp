@@ -6,6 +6,7 @@
 
 #include <cstdio>
 
+#include "cli_support.h"
 #include "small_studio.h"
 #include "tega/core/error.h"
 #include "tega/core/files.h"
@@ -142,6 +143,26 @@ TEST_F(Matte, NamesTheFileOfBadInput) {
     EXPECT_NE(std::string(e.what()).find(take.cameras[3]), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("100x80"), std::string::npos) << e.what();
   }
+}
+
+TEST_F(Matte, RunsFromTheCommandLine) {
+  const std::string inputs = " --capture " + capture().string() + " --tracked " + tracked().string();
+  const auto r = test::run_tega("matte" + inputs + " --out " + out("mattes_cli").string() + " --threads 2 --set edge.band_px=2");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find(std::to_string(13 * kFrames) + " image(s) matted"), std::string::npos) << r.output;
+  const Image8 alpha = read_image_u8(out("mattes_cli") / "expressions" / "cam00" / "000001.png");
+  EXPECT_EQ(alpha.channels, 1);
+  EXPECT_EQ(alpha.width, 512);
+
+  const auto missing = test::run_tega("matte --tracked " + tracked().string() + " --out " + out("x").string());
+  EXPECT_NE(missing.exit_code, 0);
+  EXPECT_NE(missing.output.find("--capture"), std::string::npos) << missing.output;
+  const auto unknown = test::run_tega("matte --print-options --set edge.width=3");
+  EXPECT_NE(unknown.exit_code, 0);
+  EXPECT_NE(unknown.output.find("edge.width"), std::string::npos) << unknown.output;
+  const auto printed = test::run_tega("matte --print-options --set edge.band_px=5");
+  ASSERT_EQ(printed.exit_code, 0) << printed.output;
+  EXPECT_NE(printed.output.find("band_px: 5"), std::string::npos) << printed.output;
 }
 
 }  // namespace

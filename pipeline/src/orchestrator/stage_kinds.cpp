@@ -169,7 +169,8 @@ std::vector<StageKind> make_stage_kinds() {
                        p);
   };
   kinds.push_back(track);
-  // Alpha mattes of every performance image, in the captured image space.
+  // Alpha mattes of every performance image, in the captured image space;
+  // resumes from the mattes an interrupted shard wrote.
   StageKind matte;
   matte.name = "matte";
   matte.summary = "mattes every image of the performance takes (tega matte)";
@@ -177,6 +178,7 @@ std::vector<StageKind> make_stage_kinds() {
   matte.needs = {"capture", "rig", "tracked"};
   matte.provides = {{"mattes", "mattes"}};
   matte.options_section = "matte";
+  matte.resumes_in_staging = true;
   matte.arguments = [](const ShardPaths& p) {
     return with_config({"--capture", p.artifacts.at("capture").string(), "--rig", p.artifacts.at("rig").string(),
                         "--tracked", p.artifacts.at("tracked").string(), "--out", (p.output / "mattes").string()},
