@@ -3,6 +3,7 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/ximgproc/edge_filter.hpp>
+#include <tuple>
 #include <vector>
 
 #include "tega/core/error.h"
@@ -40,10 +41,10 @@ std::vector<cv::Point> sample_points(const cv::Mat& where, int target = 200000) 
   return points;
 }
 
-// The clean plate under the frame's exposure: a per-channel gain measured on
-// the far background, where the plate and the frame show the same thing.
-cv::Mat exposed_plate(const cv::Mat& photo, const cv::Mat& plate, const std::vector<cv::Point>& background,
-                      double max_change) {
+// The frame's exposure against the clean plate: a per-channel gain measured
+// on the far background, where the plate and the frame show the same thing.
+cv::Vec3f exposure_gain(const cv::Mat& photo, const cv::Mat& plate, const std::vector<cv::Point>& background,
+                        double max_change) {
   cv::Vec3f gain(1, 1, 1);
   for (int c = 0; c < 3; ++c) {
     std::vector<float> ratios;
@@ -53,9 +54,7 @@ cv::Mat exposed_plate(const cv::Mat& photo, const cv::Mat& plate, const std::vec
     }
     if (ratios.size() > 100) gain[c] = float(std::clamp(median_of(ratios), 1 - max_change, 1 + max_change));
   }
-  cv::Mat exposed;
-  cv::multiply(plate, cv::Scalar(gain[0], gain[1], gain[2]), exposed);
-  return exposed;
+  return gain;
 }
 
 // The noise of a difference photo - plate, from its median absolute deviation.
@@ -175,14 +174,22 @@ Image8 mesh_only_matte(const cv::Mat& photo8, const cv::Mat& silhouette, int mar
   return image_of(alpha);
 }
 
-}  // namespace
+Image8 resized(const Image8& image, int width, int height, int interpolation) {
+  Image8 out(width, height, image.channels);
+  cv::Mat target = view_of(out);
+  cv::resize(view_of(image), target, cv::Size(width, height), 0, 0, interpolation);
+  return out;
+}
 
-Image8 compute_matte(const Image8& photo, const Image8* clean_plate, const Image8& silhouette, double margin_px,
-                     const MatteOptions& options) {
-  if (photo.channels != 3) throw Error("compute_matte: the photo must be RGB");
-  const auto same_size = [&](const Image8& other) { return other.width == photo.width && other.height == photo.height; };
-  if (!same_size(silhouette) || silhouette.channels != 1 || (clean_plate && (!same_size(*clean_plate) || clean_plate->channels != 3)))
-    throw Error("compute_matte: the photo, its clean plate and the mesh silhouette differ in size");
+// What unmixing needs, kept from a matte made at a smaller size to unmix the
+// full-size photo's edge.
+struct EdgeModel {
+  cv::Vec3f gain{1, 1, 1};  // exposure of the frame against the clean plate
+  cv::Mat subject_colour;   // CV_32FC3, the subject's colour near its edge; -1 where unknown
+};
+
+Image8 matte_at_this_size(const Image8& photo, const Image8* clean_plate, const Image8& silhouette, double margin_px,
+                          const MatteOptions& options, EdgeModel* edge_model = nullptr) {
   const cv::Mat photo8 = view_of(photo), mesh = view_of(silhouette);
   const int margin = std::max(1, int(std::lround(margin_px)));
   if (!clean_plate) return mesh_only_matte(photo8, mesh, margin, options);
@@ -196,7 +203,8 @@ Image8 compute_matte(const Image8& photo, const Image8* clean_plate, const Image
   cv::Mat image, plate;
   photo8.convertTo(image, CV_32FC3, 1.0 / 255);
   view_of(*clean_plate).convertTo(plate, CV_32FC3, 1.0 / 255);
-  plate = exposed_plate(image, plate, far, options.difference.max_exposure_change);
+  const cv::Vec3f gain = exposure_gain(image, plate, far, options.difference.max_exposure_change);
+  cv::multiply(plate, cv::Scalar(gain[0], gain[1], gain[2]), plate);
   // Subject: where the 3x3 mean difference stands out of that mean's noise,
   // measured on the far background (real noise is correlated: a third of one
   // pixel's would be too optimistic), cleaned, joined with the certain head,
@@ -232,6 +240,11 @@ Image8 compute_matte(const Image8& photo, const Image8* clean_plate, const Image
   const cv::Mat in_band = band_mask(roi), known_subject = subject(roi) & (in_band == 0);
   const cv::Mat colour = image(roi), background = plate(roi);
   const cv::Mat subject_colour = nearby_colour(colour, known_subject, 2 * band + 1);
+  if (edge_model) {
+    edge_model->gain = gain;
+    edge_model->subject_colour = cv::Mat(image.size(), CV_32FC3, cv::Scalar::all(-1));
+    subject_colour.copyTo(edge_model->subject_colour(roi));
+  }
   cv::Mat smooth_mask;
   cv::blur(alpha(roi), smooth_mask, cv::Size(3, 3));
 
@@ -265,6 +278,77 @@ Image8 compute_matte(const Image8& photo, const Image8* clean_plate, const Image
   unmixed.copyTo(target, in_band);
   cv::min(cv::max(alpha, 0.0), 1.0, alpha);
   return image_of(alpha);
+}
+
+// The edge of an enlarged alpha unmixed again at full size: where it is
+// fractional (the enlargement spreads the edge over about `shrink` pixels),
+// each pixel of the photo is unmixed against its own clean-plate pixel with
+// the subject colour of the small matte.
+void unmix_enlarged_edge(const Image8& photo, const Image8& plate, const EdgeModel& edge, int shrink,
+                         const MatteOptions& options, Image8& alpha) {
+  const cv::Mat& colour = edge.subject_colour;
+  const float contrast2 = float(options.edge.min_contrast * options.edge.min_contrast);
+  const auto subject_colour_at = [&](int x, int y) {
+    // Bilinear in the small image, whose pixel centres lie at (i + 0.5) * shrink.
+    const float fx = std::clamp((x + 0.5f) / shrink - 0.5f, 0.0f, float(colour.cols - 1));
+    const float fy = std::clamp((y + 0.5f) / shrink - 0.5f, 0.0f, float(colour.rows - 1));
+    const int x0 = int(fx), y0 = int(fy), x1 = std::min(x0 + 1, colour.cols - 1), y1 = std::min(y0 + 1, colour.rows - 1);
+    const float tx = fx - x0, ty = fy - y0;
+    cv::Vec3f sum(0, 0, 0);
+    float weight = 0;
+    for (const auto& [cx, cy, w] : {std::tuple{x0, y0, (1 - tx) * (1 - ty)}, std::tuple{x1, y0, tx * (1 - ty)},
+                                    std::tuple{x0, y1, (1 - tx) * ty}, std::tuple{x1, y1, tx * ty}}) {
+      const cv::Vec3f c = colour.at<cv::Vec3f>(cy, cx);
+      if (c[0] < 0 || w <= 0) continue;
+      sum += w * c;
+      weight += w;
+    }
+    return weight > 0 ? cv::Vec3f(sum / weight) : cv::Vec3f(-1, -1, -1);
+  };
+  for (int y = 0; y < photo.height; ++y) {
+    for (int x = 0; x < photo.width; ++x) {
+      uint8_t& a = alpha.at(x, y, 0);
+      if (a == 0 || a == 255) continue;
+      const cv::Vec3f F = subject_colour_at(x, y);
+      if (F[0] < 0) continue;
+      cv::Vec3f I, B;
+      for (int c = 0; c < 3; ++c) {
+        I[c] = photo.at(x, y, c) / 255.0f;
+        B[c] = edge.gain[c] * plate.at(x, y, c) / 255.0f;
+      }
+      const cv::Vec3f d = F - B;
+      const float d2 = d.dot(d);
+      if (d2 <= 0) continue;
+      const float unmixed = std::clamp((I - B).dot(d) / d2, 0.0f, 1.0f);
+      const float trust = d2 / (d2 + contrast2);
+      a = uint8_t(std::lround(255 * (trust * unmixed + (1 - trust) * a / 255.0f)));
+    }
+  }
+}
+
+}  // namespace
+
+Image8 compute_matte(const Image8& photo, const Image8* clean_plate, const Image8& silhouette, double margin_px,
+                     const MatteOptions& options) {
+  if (photo.channels != 3) throw Error("compute_matte: the photo must be RGB");
+  const auto same_size = [&](const Image8& other) { return other.width == photo.width && other.height == photo.height; };
+  if (!same_size(silhouette) || silhouette.channels != 1 || (clean_plate && (!same_size(*clean_plate) || clean_plate->channels != 3)))
+    throw Error("compute_matte: the photo, its clean plate and the mesh silhouette differ in size");
+  const int shrink = (photo.width + options.max_work_width - 1) / std::max(1, options.max_work_width);
+  if (shrink <= 1) return matte_at_this_size(photo, clean_plate, silhouette, margin_px, options);
+  // Large photos are matted at 1/shrink of their size (area-averaged) and the
+  // alpha enlarged back: the time falls with the square of the factor.
+  const int width = photo.width / shrink, height = photo.height / shrink;
+  Image8 small_silhouette = resized(silhouette, width, height, cv::INTER_AREA);
+  for (auto& p : small_silhouette.pixels) p = p >= 128 ? 255 : 0;
+  const Image8 small_plate = clean_plate ? resized(*clean_plate, width, height, cv::INTER_AREA) : Image8();
+  EdgeModel edge;
+  const Image8 small_alpha = matte_at_this_size(resized(photo, width, height, cv::INTER_AREA),
+                                                clean_plate ? &small_plate : nullptr, small_silhouette,
+                                                margin_px / shrink, options, &edge);
+  Image8 alpha = resized(small_alpha, photo.width, photo.height, cv::INTER_LINEAR);
+  if (clean_plate && !edge.subject_colour.empty()) unmix_enlarged_edge(photo, *clean_plate, edge, shrink, options, alpha);
+  return alpha;
 }
 
 }  // namespace tega::matting

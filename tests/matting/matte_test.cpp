@@ -107,6 +107,18 @@ TEST_F(Matte, FollowsAnExposureDrift) {
   EXPECT_GE(s.worst_iou, 0.98);
 }
 
+TEST_F(Matte, MattesWidePhotosAtAFractionOfTheirSize) {
+  // As 6144-pixel photos are by default: here at half size, the alpha enlarged back.
+  MatteOptions o = options();
+  o.max_work_width = 256;
+  matte_capture({capture(), tracked(), out("mattes_half"), {}, {}}, o);
+  const MatteScores s = score_mattes(out("mattes_half"), capture(), "expressions");
+  print_scores("matted at half size", s);
+  EXPECT_LE(s.worst_mean_error, 0.02);
+  EXPECT_LE(s.boundary_error, 0.15);
+  EXPECT_GE(s.worst_iou, 0.97);
+}
+
 TEST_F(Matte, FallsBackOnTheMeshWithoutACleanPlate) {
   MatteOptions o = options();
   o.use_clean_plate = false;
