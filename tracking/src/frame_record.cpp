@@ -6,6 +6,7 @@
 #include "tega/core/error.h"
 #include "tega/core/files.h"
 #include "tega/core/mesh.h"
+#include "tega/tracking/tracked.h"
 
 namespace tega::tracking {
 namespace fs = std::filesystem;
@@ -70,26 +71,22 @@ std::optional<StoredFrame> read_frame_record(const fs::path& take_dir, int frame
   if (!fs::exists(file)) return std::nullopt;
   StoredFrame stored;
   FrameRecord& record = stored.record;
-  try {
-    const auto j = nlohmann::json::parse(read_text_file(file));
-    record.frame = j.at("frame");
-    record.status = j.at("status");
-    record.reason = j.value("reason", "");
-    if (record.status != "skipped") {
-      Eigen::Matrix<double, 3, 4> m;
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 4; ++c) m(r, c) = j.at("head_to_world").at(r).at(c);
-      record.state.head_to_world = RigidTransform::from_matrix(m);
-      const auto& expression = j.at("expression");
-      for (const auto& name : model.shapes.expression_names) {
-        if (!expression.contains(name))
-          throw Error(file, "has no coefficient for expression " + name + " of the model " + model.directory.string());
-        record.state.expression.push_back(expression.at(name));
-      }
-      record.residuals = residuals_of(j.at("residuals"));
+  const TrackedFrame tracked = read_tracked_frame(file);
+  record.frame = tracked.frame;
+  record.status = tracked.status;
+  record.reason = tracked.reason;
+  if (record.status != "skipped") {
+    record.state.head_to_world = tracked.head_to_world;
+    for (const auto& name : model.shapes.expression_names) {
+      if (!tracked.expression.count(name))
+        throw Error(file, "has no coefficient for expression " + name + " of the model " + model.directory.string());
+      record.state.expression.push_back(tracked.expression.at(name));
     }
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(file, std::string("is not a valid frame record: ") + e.what());
+    try {
+      record.residuals = residuals_of(nlohmann::json::parse(read_text_file(file)).at("residuals"));
+    } catch (const nlohmann::json::exception& e) {
+      throw Error(file, std::string("is not a valid frame record: ") + e.what());
+    }
   }
   stored.state = record.state;
   if (record.status == "tracked" && subject) {

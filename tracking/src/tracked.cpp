@@ -36,6 +36,27 @@ TrackedSubject read_tracked_subject(const fs::path& tracked) {
   return subject;
 }
 
+TrackedFrame read_tracked_frame(const fs::path& file) {
+  TrackedFrame f;
+  try {
+    const auto j = nlohmann::json::parse(read_text_file(file));
+    f.frame = j.at("frame");
+    f.status = j.at("status");
+    f.reason = j.value("reason", "");
+    if (f.status != "skipped") {
+      Eigen::Matrix<double, 3, 4> m;
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c) m(r, c) = j.at("head_to_world").at(r).at(c);
+      f.head_to_world = RigidTransform::from_matrix(m);
+      for (const auto& [name, value] : j.at("expression").items()) f.expression[name] = value.get<double>();
+    }
+    if (f.tracked()) f.mesh = file.parent_path() / j.at("mesh").get<std::string>();
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(file, std::string("is not a valid frame record: ") + e.what());
+  }
+  return f;
+}
+
 std::vector<TrackedFrame> read_tracked_take(const fs::path& tracked, const std::string& take) {
   const fs::path dir = tracked / take;
   if (!fs::exists(dir / "track.json"))
@@ -49,23 +70,7 @@ std::vector<TrackedFrame> read_tracked_take(const fs::path& tracked, const std::
   std::sort(records.begin(), records.end());
   std::vector<TrackedFrame> frames;
   for (const fs::path& file : records) {
-    TrackedFrame f;
-    try {
-      const auto j = nlohmann::json::parse(read_text_file(file));
-      f.frame = j.at("frame");
-      f.status = j.at("status");
-      f.reason = j.value("reason", "");
-      if (f.status != "skipped") {
-        Eigen::Matrix<double, 3, 4> m;
-        for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 4; ++c) m(r, c) = j.at("head_to_world").at(r).at(c);
-        f.head_to_world = RigidTransform::from_matrix(m);
-        for (const auto& [name, value] : j.at("expression").items()) f.expression[name] = value.get<double>();
-      }
-      if (f.tracked()) f.mesh = dir / j.at("mesh").get<std::string>();
-    } catch (const nlohmann::json::exception& e) {
-      throw Error(file, std::string("is not a valid frame record: ") + e.what());
-    }
+    TrackedFrame f = read_tracked_frame(file);
     if (f.tracked() && !fs::exists(f.mesh)) throw Error(f.mesh, "is missing (its record " + file.string() + " says tracked)");
     frames.push_back(std::move(f));
   }

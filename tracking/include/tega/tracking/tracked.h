@@ -35,6 +35,10 @@ struct TrackedFrame {
 // file when one is missing or damaged.
 TrackedSubject read_tracked_subject(const std::filesystem::path& tracked);
 
+// One frame's record, TRACKED/<take>/<frame:06d>.json. Throws tega::Error
+// naming the file when it is damaged.
+TrackedFrame read_tracked_frame(const std::filesystem::path& record);
+
 // Every frame of TRACKED/<take>/ that has a record, in frame order. Throws
 // tega::Error naming the file when the take was not tracked to its end
 // (no track.json) or a record is damaged.
