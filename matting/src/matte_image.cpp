@@ -87,6 +87,18 @@ cv::Mat unexplained(const cv::Mat& photo, const cv::Mat& plate, double shading) 
   return out;
 }
 
+// Alpha of colour I between the subject's colour F and the known background B
+// (I = a F + (1 - a) B, least squares), leaning on `prior` as far as F and B
+// are alike: the unmixing is noise there.
+float unmix(const cv::Vec3f& I, const cv::Vec3f& F, const cv::Vec3f& B, float prior, float contrast2) {
+  const cv::Vec3f d = F - B;
+  const float d2 = d.dot(d);
+  if (d2 <= 0) return prior;
+  const float a = std::clamp((I - B).dot(d) / d2, 0.0f, 1.0f);
+  const float trust = d2 / (d2 + contrast2);
+  return trust * a + (1 - trust) * prior;
+}
+
 cv::Mat disk(int radius) {
   return cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1));
 }
@@ -248,8 +260,7 @@ Image8 matte_at_this_size(const Image8& photo, const Image8* clean_plate, const 
   cv::Mat smooth_mask;
   cv::blur(alpha(roi), smooth_mask, cv::Size(3, 3));
 
-  // Unmixing I = a F + (1 - a) B against the known background B, trusted as
-  // far as F and B differ.
+  // Unmixing against the known background.
   cv::Mat unmixed = alpha(roi).clone();
   const float contrast2 = float(options.edge.min_contrast * options.edge.min_contrast);
   for (int y = 0; y < roi.height; ++y) {
@@ -261,11 +272,7 @@ Image8 matte_at_this_size(const Image8& photo, const Image8* clean_plate, const 
         unmixed.at<float>(y, x) = prior;
         continue;
       }
-      const cv::Vec3f d = F - B;
-      const float d2 = d.dot(d);
-      const float a = d2 > 0 ? std::clamp((colour.at<cv::Vec3f>(y, x) - B).dot(d) / d2, 0.0f, 1.0f) : prior;
-      const float trust = d2 / (d2 + contrast2);
-      unmixed.at<float>(y, x) = trust * a + (1 - trust) * prior;
+      unmixed.at<float>(y, x) = unmix(colour.at<cv::Vec3f>(y, x), F, B, prior, contrast2);
     }
   }
   if (options.edge.guided_filter_radius_px > 0) {
@@ -316,12 +323,7 @@ void unmix_enlarged_edge(const Image8& photo, const Image8& plate, const EdgeMod
         I[c] = photo.at(x, y, c) / 255.0f;
         B[c] = edge.gain[c] * plate.at(x, y, c) / 255.0f;
       }
-      const cv::Vec3f d = F - B;
-      const float d2 = d.dot(d);
-      if (d2 <= 0) continue;
-      const float unmixed = std::clamp((I - B).dot(d) / d2, 0.0f, 1.0f);
-      const float trust = d2 / (d2 + contrast2);
-      a = uint8_t(std::lround(255 * (trust * unmixed + (1 - trust) * a / 255.0f)));
+      a = uint8_t(std::lround(255 * unmix(I, F, B, a / 255.0f, contrast2)));
     }
   }
 }
