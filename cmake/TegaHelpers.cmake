@@ -11,12 +11,22 @@ endfunction()
 # tega_test(NAME SOURCES ... LINK ...): one GoogleTest executable registered with CTest.
 # Tests run from the build folder; TEGA_SHARED_DATA points at ../shared/data
 # (tests that need it skip cleanly when it is absent).
+# A test executable; ctest runs each of its tests in a process of its own,
+# or, with SUITES, each named suite in one process, so that a suite's
+# expensive fixture (a rendered virtual-studio capture) is made once.
 function(tega_test name)
-  cmake_parse_arguments(ARG "" "" "SOURCES;LINK" ${ARGN})
+  cmake_parse_arguments(ARG "" "" "SOURCES;LINK;SUITES" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_LINK} tega_test_support GTest::gtest GTest::gtest_main)
-  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 120
-    PROPERTIES ENVIRONMENT "TEGA_SHARED_DATA=${TEGA_SHARED_DATA_DIR}")
+  if(ARG_SUITES)
+    foreach(suite ${ARG_SUITES})
+      add_test(NAME ${suite} COMMAND ${name} --gtest_filter=${suite}.*)
+      set_tests_properties(${suite} PROPERTIES ENVIRONMENT "TEGA_SHARED_DATA=${TEGA_SHARED_DATA_DIR}")
+    endforeach()
+  else()
+    gtest_discover_tests(${name} DISCOVERY_TIMEOUT 120
+      PROPERTIES ENVIRONMENT "TEGA_SHARED_DATA=${TEGA_SHARED_DATA_DIR}")
+  endif()
 endfunction()
 
 function(tega_print_summary)
