@@ -1,8 +1,10 @@
 // `tega matte` over a capture: every image of every tracked frame, camera by
 // camera (one clean plate in memory at a time), frames in parallel.
+#include <atomic>
 #include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "recorded_image.h"
 #include "tega/core/error.h"
