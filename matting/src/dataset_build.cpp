@@ -1,7 +1,5 @@
 #include "tega/matting/dataset_build.h"
 
-#include <spdlog/spdlog.h>
-
 #include <algorithm>
 #include <cstdio>
 #include <memory>
@@ -12,6 +10,7 @@
 #include "tega/core/error.h"
 #include "tega/core/files.h"
 #include "tega/core/image_header.h"
+#include "tega/core/log.h"
 #include "tega/core/options.h"
 #include "tega/core/progress.h"
 #include "tega/core/rig.h"
@@ -132,8 +131,8 @@ Inputs read_inputs(const DatasetBuildRequest& request, const DatasetBuildOptions
     }
   }
   if (incomplete > 0)
-    spdlog::warn("dataset build: {} tracked frame(s) left out: a camera has no image of them (take.json: missing)",
-                 incomplete);
+    logging::warn("dataset build: %d tracked frame(s) left out: a camera has no image of them (take.json: missing)",
+                  incomplete);
   if (in.candidates.empty())
     throw Error(request.tracked, "has no tracked frame that every camera recorded: nothing to build a dataset from");
   return in;
