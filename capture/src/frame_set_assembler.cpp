@@ -12,6 +12,7 @@ FrameSetAssembler::FrameSetAssembler(int cameras, int64_t tolerance, int64_t set
       timeout_ns_(set_timeout_ns),
       active_(cameras, true),
       latest_key_(cameras, INT64_MIN),
+      first_key_(cameras, INT64_MAX),
       late_(cameras, 0) {}
 
 bool FrameSetAssembler::closable(const OpenSet& open, int64_t now_ns) const {
@@ -28,7 +29,10 @@ bool FrameSetAssembler::closable(const OpenSet& open, int64_t now_ns) const {
 std::vector<FrameSet> FrameSetAssembler::close_ready(int64_t now_ns) {
   std::vector<FrameSet> closed;
   while (!open_.empty() && closable(open_.front(), now_ns)) {
-    last_emitted_key_ = open_.front().set.key;
+    FrameSet& set = open_.front().set;
+    for (int c = 0; c < cameras_; ++c)
+      if (!set.frames[c] && active_[c] && first_key_[c] > set.key + tolerance_) set.before_all_streaming = true;
+    last_emitted_key_ = set.key;
     emitted_any_ = true;
     closed.push_back(std::move(open_.front().set));
     open_.erase(open_.begin());
@@ -39,6 +43,7 @@ std::vector<FrameSet> FrameSetAssembler::close_ready(int64_t now_ns) {
 std::vector<FrameSet> FrameSetAssembler::add(Frame frame, int64_t key, int64_t now_ns) {
   const int c = frame.camera;
   latest_key_[c] = std::max(latest_key_[c], key);
+  first_key_[c] = std::min(first_key_[c], key);
   if (!active_[c] || (emitted_any_ && key <= last_emitted_key_ + tolerance_)) {
     ++late_[c];
     return close_ready(now_ns);

@@ -77,6 +77,12 @@ class Recording {
     bool gap_only = true;  // missing only cameras already lost: the take goes on without them
     for (size_t c = 0; c < set.frames.size(); ++c)
       if (!set.frames[c] && !outcome_.cameras[c].lost) gap_only = false;
+    if (!gap_only && set.before_all_streaming) {
+      ++outcome_.before_all_streaming;
+      record.status = "before_all_streaming";
+      files_.add(std::move(record));
+      return;
+    }
     const bool incomplete = !set.complete() && !gap_only;
     if (incomplete) ++outcome_.incomplete_sets;
     if (incomplete && rig_.sync.incomplete_sets == "drop") {

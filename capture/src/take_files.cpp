@@ -116,6 +116,7 @@ int TakeFiles::finalise(const fs::path& folder, const RigConfig& rig, const Take
       {"error", outcome.error.empty() ? nlohmann::json(nullptr) : nlohmann::json(outcome.error)},
       {"counts",
        {{"frame_sets_seen", outcome.sets_seen},
+        {"before_all_streaming", outcome.before_all_streaming},
         {"incomplete", outcome.incomplete_sets},
         {"incomplete_dropped", outcome.incomplete_dropped},
         {"writer_full_dropped", outcome.writer_full_dropped}}},

@@ -38,6 +38,29 @@ TEST(FrameSetAssembler, ASetMissingACameraClosesOnceThatCameraMovedPast) {
   EXPECT_TRUE(second[0].complete());
 }
 
+TEST(FrameSetAssembler, SetsBeforeACameraStartedStreamingAreMarkedAsSuch) {
+  FrameSetAssembler a(2, 5 * kMs, 50 * kMs);
+  a.add(frame_of(0, 1), 100 * kMs, 0);
+  // Camera 1's first frame comes an instant later: the first set closes without it.
+  const auto first = a.add(frame_of(1, 1), 133 * kMs, 0);
+  ASSERT_EQ(first.size(), 1u);
+  EXPECT_TRUE(first[0].before_all_streaming);
+  EXPECT_TRUE(a.add(frame_of(0, 2), 134 * kMs, 0)[0].complete());
+  // Once both stream, a missed instant is a true gap.
+  a.add(frame_of(0, 3), 166 * kMs, 0);
+  const auto gap = a.add(frame_of(1, 4), 200 * kMs, 0);
+  ASSERT_EQ(gap.size(), 1u);
+  EXPECT_FALSE(gap[0].complete());
+  EXPECT_FALSE(gap[0].before_all_streaming);
+
+  // A camera that has delivered nothing yet when the set times out has not started either.
+  FrameSetAssembler silent(2, 5 * kMs, 50 * kMs);
+  silent.add(frame_of(0, 1), 100 * kMs, 0);
+  const auto timed_out = silent.tick(60 * kMs);
+  ASSERT_EQ(timed_out.size(), 1u);
+  EXPECT_TRUE(timed_out[0].before_all_streaming);
+}
+
 TEST(FrameSetAssembler, TimeoutAndLostCamerasCloseSetsInOrder) {
   FrameSetAssembler a(2, 5 * kMs, 50 * kMs);
   a.add(frame_of(0, 1), 100 * kMs, 0);

@@ -37,7 +37,6 @@ TEST(FakeRig, ThirteenCamerasRecordCompleteFrameSetsHoldingTheCamerasPixels) {
   const TakeOutcome outcome = record_take(rig, request("expressions", 12), capture.path());
 
   EXPECT_EQ(outcome.frames, 12);
-  EXPECT_EQ(outcome.incomplete_sets, 0);
   EXPECT_TRUE(outcome.error.empty()) << outcome.error;
   const TakeInfo take = read_take(capture / "takes/expressions");
   EXPECT_EQ(take.frames, 12);
@@ -47,6 +46,18 @@ TEST(FakeRig, ThirteenCamerasRecordCompleteFrameSetsHoldingTheCamerasPixels) {
   validate_capture(capture.path());  // the layout checks every stage relies on
 
   const auto sets = test::read_frame_sets(capture / "takes/expressions");
+  // Free-running cameras stamped on arrival: the cameras' start-up skew is
+  // set apart, and a loaded machine may still delay a frame past half a
+  // period now and then, but every such set is listed and none is written.
+  int incomplete = 0, starting = 0;
+  for (const auto& row : sets) {
+    incomplete += row.at("status") == "incomplete_dropped";
+    starting += row.at("status") == "before_all_streaming";
+    if (row.at("frame") != "-1") EXPECT_EQ(row.at("status"), "complete");
+  }
+  EXPECT_EQ(incomplete, outcome.incomplete_sets);
+  EXPECT_EQ(starting, outcome.before_all_streaming);
+  EXPECT_LE(outcome.incomplete_sets, 2) << "timestamps no longer group the cameras' frames";
   int checked = 0;
   for (const auto& row : sets) {
     if (row.at("frame") == "-1") continue;

@@ -24,6 +24,10 @@ struct Frame {
 struct FrameSet {
   int64_t key = 0;  // the timestamp (ns) or frame id the set was grouped by
   std::vector<std::optional<Frame>> frames;  // one slot per camera; empty = missing
+  // Closed while a camera it lacks had not started streaming yet: the rig's
+  // cameras start one after another, so a take's first instants miss the
+  // last ones. Such a set says nothing about synchronisation.
+  bool before_all_streaming = false;
   bool complete() const {
     for (const auto& f : frames)
       if (!f) return false;

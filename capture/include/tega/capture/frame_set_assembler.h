@@ -2,8 +2,10 @@
 // Groups the frames of all cameras into frame sets by a key (a timestamp in
 // ns, or a frame id) within a tolerance, and closes each set: complete, or
 // incomplete when every missing camera has moved past it, when it waited
-// longer than the timeout, or when a missing camera was lost. Sets come out
-// oldest first. Not thread-safe: the recorder serialises calls.
+// longer than the timeout, or when a missing camera was lost. A set missing a
+// camera whose first frame came after it (or has not come yet) is marked
+// before_all_streaming. Sets come out oldest first. Not thread-safe: the
+// recorder serialises calls.
 #include <cstdint>
 #include <vector>
 
@@ -40,6 +42,7 @@ class FrameSetAssembler {
   std::vector<OpenSet> open_;  // ascending key
   std::vector<bool> active_;
   std::vector<int64_t> latest_key_;  // per camera; INT64_MIN before its first frame
+  std::vector<int64_t> first_key_;   // per camera; INT64_MAX before its first frame
   std::vector<int64_t> late_;
   bool emitted_any_ = false;
   int64_t last_emitted_key_ = 0;

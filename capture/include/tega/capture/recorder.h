@@ -40,6 +40,7 @@ struct TakeOutcome {
   std::filesystem::path folder;  // CAPTURE/takes/<take>
   int frames = 0;                // frames of the take (frame sets written)
   int64_t sets_seen = 0, incomplete_sets = 0, incomplete_dropped = 0, writer_full_dropped = 0;
+  int64_t before_all_streaming = 0;  // sets discarded while the cameras were still starting
   std::string stop_reason;       // why the take ended
   std::string error;             // the write error that stopped it; "" = none
   double seconds = 0;
