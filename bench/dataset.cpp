@@ -10,17 +10,23 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
+#include <optional>
 
 #include "tega/core/downsample.h"
 #include "tega/core/files.h"
 #include "tega/core/image.h"
+#include "tega/core/mesh.h"
 #include "tega/core/rig.h"
 #include "tega/core/take.h"
 #include "tega/core/undistort.h"
 #include "tega/matting/dataset_build.h"
+#include "tega/matting/dataset_image.h"
 #include "tega/matting/matte.h"
+#include "tega/mvs/debayer.h"
+#include "tega/mvs/frame_views.h"
 #include "tega/synth/virtual_studio.h"
 #include "tega/tracking/evaluation.h"
+#include "tega/tracking/tracked.h"
 
 #ifdef TEGA_BENCH_HAVE_ZSTD
 #include <zstd.h>
@@ -75,26 +81,75 @@ void storage_table(const Image8& rgba, const fs::path& dir, int repeats) {
 #endif
 }
 
+// A captured image as the stages see it: RGB, debayered where it is raw.
+Image8 read_photo(const TakeInfo& take, const std::string& camera, int frame) {
+  const fs::path file = take.image_path(camera, frame);
+  return mvs::recorded_rgb(read_image_u8(file), take, mvs::debayer, file.string());
+}
+
+// Every take of the capture stored as raw BayerRG8 (R G / G B), the way
+// tega capture writes a studio camera's frames (PNG level 1).
+void mosaic_capture(const fs::path& capture) {
+  for (const auto& listed : read_capture(capture).takes) {
+    TakeInfo take = read_take(capture / "takes" / listed.name);
+    if (take.pixel_format.rfind("Bayer", 0) == 0 || take.kind == "calibration") continue;
+    for (const auto& camera : take.cameras) {
+      for (int frame = 0; frame < take.frames; ++frame) {
+        if (!take.has_image(camera, frame)) continue;
+        const Image8 rgb = read_image_u8(take.image_path(camera, frame));
+        Image8 raw(rgb.width, rgb.height, 1);
+        for (int y = 0; y < rgb.height; ++y)
+          for (int x = 0; x < rgb.width; ++x) raw.at(x, y, 0) = rgb.at(x, y, (y % 2) + (x % 2));
+        write_png_view({raw.pixels.data(), raw.width, raw.height, 1, 8, size_t(raw.width)}, take.image_path(camera, frame),
+                       1);
+      }
+    }
+    take.pixel_format = "BayerRG8";
+    write_take(take, take.folder);
+  }
+}
+
 // One image's steps, one thread: where the time of a build goes.
-void stage_table(const fs::path& capture, const Camera& camera, const UndistortionMaps& maps, int downsample) {
+void stage_table(const fs::path& capture, const Camera& camera, int downsample) {
   const TakeInfo take = read_take(capture / "takes" / "expressions");
   Image8 rgb, matte, rgba, undistorted, small;
-  const double read_s = timed(1, [&] { rgb = read_image_u8(take.image_path(camera.name, 0)); });
+  const double read_s = timed(1, [&] { rgb = read_photo(take, camera.name, 0); });
   const double matte_s =
       timed(1, [&] { matte = read_image_u8(capture / "ground_truth" / "expressions" / "alpha" / camera.name / "000000.png"); });
-  const double compose_s = timed(1, [&] {
-    rgba = Image8(rgb.width, rgb.height, 4);
-    for (size_t i = 0; i < matte.pixels.size(); ++i) {
-      for (int c = 0; c < 3; ++c) rgba.pixels[4 * i + c] = rgb.pixels[3 * i + c];
-      rgba.pixels[4 * i + 3] = matte.pixels[i];
-    }
-  });
-  const double undistort_s = timed(1, [&] { undistorted = undistort_image(rgba, maps); });
-  const double downsample_s = timed(1, [&] { small = box_downsample(undistorted, downsample); });
-  const double one_pass_s = timed(1, [&] { small = undistort_image(rgba, maps, downsample); });
-  std::printf("\none image, one thread (s): read %dx%d RGB %.2f, read matte %.2f, to RGBA %.2f, undistort %.2f, "
-              "downsample %.2f; both in one pass (what the build does) %.2f; writing: below\n",
-              rgb.width, rgb.height, read_s, matte_s, compose_s, undistort_s, downsample_s, one_pass_s);
+  rgba = Image8(rgb.width, rgb.height, 4);
+  for (size_t i = 0; i < matte.pixels.size(); ++i) {
+    for (int c = 0; c < 3; ++c) rgba.pixels[4 * i + c] = rgb.pixels[3 * i + c];
+    rgba.pixels[4 * i + 3] = matte.pixels[i];
+  }
+  const UndistortionMaps maps = camera.undistortion_maps();
+  const double core_s = timed(1, [&] { small = undistort_image(rgba, maps, downsample); });
+  std::optional<matting::DatasetResampler> resampler;
+  resampler.emplace(camera, downsample);
+  const double resampler_s = timed(3, [&] { small = resampler->rgba(rgb, matte); });
+  std::printf("\none image, one thread (s): read the %dx%d capture as RGB %.2f, read its matte %.2f; RGB + matte to "
+              "the dataset's RGBA with OpenCV (what the build does) %.2f, core's undistort_image of the RGBA %.2f; "
+              "writing: below\n",
+              rgb.width, rgb.height, read_s, matte_s, resampler_s, core_s);
+}
+
+// One image's matte, one thread: where the time of tega matte goes.
+void matte_table(const fs::path& capture, const fs::path& tracked, const Camera& camera) {
+  const TakeInfo take = read_take(capture / "takes" / "expressions");
+  const TakeInfo plate_take = read_take(capture / "takes" / "clean_plate");
+  const tracking::TrackedSubject subject = tracking::read_tracked_subject(tracked);
+  const tracking::TrackedFrame frame = tracking::read_tracked_take(tracked, "expressions").front();
+  Image8 photo, alpha;
+  Vertices world;
+  const double read_s = timed(1, [&] { photo = read_photo(take, camera.name, frame.frame); });
+  const double mesh_s = timed(1, [&] { world = read_vertices_bin(frame.mesh, subject.neutral.num_vertices()); });
+  const matting::CameraMatting matting(camera, read_photo(plate_take, camera.name, 0), matting::MatteOptions());
+  const double matte_s = timed(3, [&] { alpha = matting.matte(photo, world, subject.neutral.faces); });
+  const fs::path file = fs::temp_directory_path() / "tega-bench-matte.png";
+  const double write_s = timed(3, [&] { matting::write_matte(alpha, file); });
+  fs::remove(file);
+  std::printf("\none matte, one thread (s): read the %dx%d capture as RGB %.2f, read the mesh %.3f, matte "
+              "(silhouette included) %.2f, write %.2f\n",
+              photo.width, photo.height, read_s, mesh_s, matte_s, write_s);
 }
 
 }  // namespace
@@ -114,6 +169,10 @@ int main(int argc, char** argv) {
   app.add_option("--threads", threads, "Worker threads (the target machine has 2 cores).");
   app.add_option("--png-levels", levels, "PNG compression levels to build the dataset with.");
   app.add_option("--repeats", repeats, "Repeats of each storage measurement.");
+  bool bayer = false;
+  app.add_flag("--bayer", bayer,
+               "Store the captured images as a studio camera records them, raw BayerRG8 mosaics (a third of the "
+               "bytes to decode), debayered by the stages.");
   CLI11_PARSE(app, argc, argv);
 
   const fs::path work = work_dir;
@@ -137,29 +196,43 @@ int main(int argc, char** argv) {
     synth::render_virtual_studio(studio, capture, true);
     std::printf("rendered in %.1f s\n", seconds_since(start));
   }
+  if (bayer) mosaic_capture(capture);
   const fs::path tracked = work / "tracked", mattes = work / "mattes";
   remove_tree(tracked);
   remove_tree(mattes);
   tracking::write_studio_truth_as_tracked(capture, tracked);
+  const Rig rig = read_rig_json(capture / "rig.json");
+  const TakeInfo take = read_take(capture / "takes" / "expressions");
+  std::printf("captured images: %s, %dx%d\n", take.pixel_format.c_str(), width, height);
+
+  // What a camera costs once, whatever its frame count (a 400-frame dataset
+  // pays it once per 400 images, this bench once per `frames`): the
+  // resampler's maps, and for matting the clean plate, read and shrunk.
+  const Camera& first_camera = rig.cameras.front();
+  const double resampler_s = timed(1, [&] { matting::DatasetResampler(first_camera, downsample); });
+  const double plate_s = timed(1, [&] {
+    matting::CameraMatting(first_camera, read_photo(read_take(capture / "takes" / "clean_plate"), first_camera.name, 0),
+                           matting::MatteOptions());
+  });
+  std::printf("once per camera (s): the resampler's maps %.2f, the clean plate read and shrunk %.2f\n", resampler_s,
+              plate_s);
+
+  std::printf("\n%-44s %8s %10s %10s %14s %16s\n", "run (2 threads)", "images", "seconds", "images/s",
+              "images/s steady", "CPU s per image");
+  const auto report = [&](const std::string& name, int images, double seconds, double cpu, double per_camera_s) {
+    // Per-camera set-up runs on one thread while the others wait.
+    const double setup = per_camera_s * double(rig.cameras.size());
+    std::printf("%-44s %8d %10.1f %10.2f %14.2f %16.2f\n", name.c_str(), images, seconds, images / seconds,
+                images / (seconds - setup), (cpu - setup) / images);
+  };
   matting::MatteOptions matte_options;
   matte_options.threads = threads;
-  const auto matte_start = Clock::now();
-  const double matte_cpu_start = cpu_seconds();
+  auto start = Clock::now();
+  double cpu_start = cpu_seconds();
   const matting::MatteSummary matted = matting::matte_capture({capture, tracked, mattes}, matte_options);
-  const double matte_s = seconds_since(matte_start), matte_cpu = cpu_seconds() - matte_cpu_start;
-  std::printf("tega matte: %d images in %.1f s, %.2f images/s, %.2f CPU s per image\n", matted.images, matte_s,
-              matted.images / matte_s, matte_cpu / matted.images);
+  const double matte_s = seconds_since(start), matte_cpu = cpu_seconds() - cpu_start;
+  report("tega matte", matted.images, matte_s, matte_cpu, plate_s);
 
-  // Undistortion maps are made once per camera: a dataset of 400 frames pays
-  // them once per 400 images, this bench once per `frames`.
-  const Rig rig = read_rig_json(capture / "rig.json");
-  const auto maps_start = Clock::now();
-  const UndistortionMaps maps = rig.cameras.front().undistortion_maps();
-  const double maps_s = seconds_since(maps_start);
-  std::printf("undistortion maps: %.2f s per camera (%dx%d)\n", maps_s, maps.width, maps.height);
-
-  std::printf("\n%-10s %8s %10s %10s %14s %22s %16s\n", "png level", "images", "seconds", "images/s",
-              "MB per image", "images/s without maps", "CPU s per image");
   fs::path last;
   for (const int level : levels) {
     matting::DatasetBuildOptions options;
@@ -167,26 +240,31 @@ int main(int argc, char** argv) {
     options.frames = 0;
     options.threads = threads;
     options.png_compression = level;
-    const matting::DatasetBuildRequest request{capture, tracked, mattes, work / ("dataset" + std::to_string(level)),
-                                               {}, true};
-    const auto start = Clock::now();
-    const double cpu_start = cpu_seconds();
-    const auto summary = matting::build_dataset(request, options);
-    const double seconds = seconds_since(start), cpu = cpu_seconds() - cpu_start;
+    const std::string suffix = " (PNG level " + std::to_string(level) + ")";
+    start = Clock::now();
+    cpu_start = cpu_seconds();
+    const auto two_stage = matting::build_dataset(
+        {capture, tracked, mattes, work / ("dataset" + std::to_string(level)), {}, true}, options);
+    const double build_s = seconds_since(start), build_cpu = cpu_seconds() - cpu_start;
+    report("tega dataset build --mattes" + suffix, two_stage.images, build_s, build_cpu, resampler_s);
+    report("  both stages" + suffix, two_stage.images, matte_s + build_s, matte_cpu + build_cpu, plate_s + resampler_s);
+
+    start = Clock::now();
+    cpu_start = cpu_seconds();
+    const auto one_pass = matting::build_dataset(
+        {capture, tracked, {}, work / ("dataset-matted-here" + std::to_string(level)), {}, true}, options);
+    report("tega dataset build, matting here" + suffix, one_pass.images, seconds_since(start),
+           cpu_seconds() - cpu_start, plate_s + resampler_s);
     uintmax_t bytes = 0;
-    for (const auto& entry : fs::recursive_directory_iterator(summary.dataset / "images"))
+    for (const auto& entry : fs::recursive_directory_iterator(one_pass.dataset / "images"))
       if (entry.is_regular_file()) bytes += entry.file_size();
-    // The maps of each camera are made by one thread while the other waits.
-    const double steady = seconds - maps_s * double(rig.cameras.size());
-    std::printf("%-10d %8d %10.1f %10.2f %14.2f %22.2f %16.2f\n", level, summary.images, seconds,
-                summary.images / seconds, double(bytes) / 1e6 / summary.images, summary.images / steady,
-                (cpu - maps_s * double(rig.cameras.size())) / summary.images);
-    std::printf("  with the mattes: %.2f images/s\n", summary.images / (seconds + matte_s));
-    last = summary.dataset;
+    std::printf("  %.2f MB per image\n", double(bytes) / 1e6 / one_pass.images);
+    last = one_pass.dataset;
   }
 
-  stage_table(capture, rig.cameras.front(), maps, downsample);
-  const auto first = *fs::recursive_directory_iterator(last / "images" / rig.cameras.front().name);
+  matte_table(capture, tracked, first_camera);
+  stage_table(capture, first_camera, downsample);
+  const auto first = *fs::recursive_directory_iterator(last / "images" / first_camera.name);
   storage_table(read_image_u8(first.path()), work, repeats);
   return 0;
 }

@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <memory>
+#include <optional>
 
-#include "dataset_image.h"
+#include "clean_plate.h"
 #include "recorded_image.h"
 #include "tega/core/dataset.h"
 #include "tega/core/error.h"
@@ -17,6 +17,8 @@
 #include "tega/core/take.h"
 #include "tega/core/thread_pool.h"
 #include "tega/core/undistort.h"
+#include "tega/matting/dataset_image.h"
+#include "tega/matting/matte.h"
 #include "tega/tracking/tracked.h"
 
 namespace tega::matting {
@@ -66,6 +68,7 @@ struct Inputs {
   std::vector<TakeInfo> takes;
   tracking::TrackedSubject subject;
   std::vector<Candidate> candidates;
+  std::optional<TakeInfo> clean_plate;  // matting here: the empty studio's take, if any
   std::string fingerprint;  // what the images depend on besides the options: the resume key
 };
 
@@ -105,20 +108,29 @@ Inputs read_inputs(const DatasetBuildRequest& request, const DatasetBuildOptions
   if (!in.subject.neutral.has_uvs())
     throw Error(request.tracked / "identity.json", "names a neutral mesh without UVs; the dataset's template needs them");
 
+  const bool matting_here = request.mattes.empty();
   in.fingerprint = "capture: " + fs::absolute(request.capture).string() + "\nrig: " + read_text_file(in.rig_file) +
                    "\ntracked: " + fs::absolute(request.tracked).string() +
-                   "\nmattes: " + fs::absolute(request.mattes).string() + "\n";
+                   "\nmattes: " + (matting_here ? "made here" : fs::absolute(request.mattes).string()) + "\n";
+  if (matting_here) {
+    in.clean_plate = clean_plate_take(in.capture, options.matte);
+    for (const Camera& camera : in.rig.cameras)
+      if (in.clean_plate && !in.clean_plate->has_image(camera.name, 0))
+        throw Error(in.clean_plate->image_path(camera.name, 0), "is missing: camera " + camera.name + " has no clean plate");
+  }
   const std::vector<std::string> names = in.capture.performance_takes({}, "to build a dataset from");
   in.takes.reserve(names.size());  // candidates point into it
   int incomplete = 0;
   for (const auto& name : names) {
     const TakeInfo& take = in.takes.emplace_back(read_take(in.capture.root / "takes" / name));
-    const fs::path mattes_done = request.mattes / name / kMattesDone;
-    if (!fs::exists(mattes_done))
-      throw Error(mattes_done, "is missing: take " + name + " was not matted to its end (run tega matte)");
+    if (!matting_here) {
+      const fs::path mattes_done = request.mattes / name / kMattesDone;
+      if (!fs::exists(mattes_done))
+        throw Error(mattes_done, "is missing: take " + name + " was not matted to its end (run tega matte)");
+      in.fingerprint += name + " mattes: " + read_text_file(mattes_done) + "\n";
+    }
     std::vector<tracking::TrackedFrame> tracked = tracking::read_tracked_take(request.tracked, name);
-    in.fingerprint += name + " mattes: " + read_text_file(mattes_done) + "\n" + name +
-                      " tracked: " + read_text_file(request.tracked / name / "track.json") + "\n";
+    in.fingerprint += name + " tracked: " + read_text_file(request.tracked / name / "track.json") + "\n";
     for (auto& frame : tracked) {
       if (!frame.tracked()) continue;
       if (frame.frame < 0 || frame.frame >= take.frames)
@@ -162,7 +174,8 @@ void choose_cameras(Dataset& dataset, const Inputs& in, const DatasetBuildOption
 }
 
 // Everything that can be checked cheaply, before the heavy work: each image
-// and matte exists, and the mattes have the captured size.
+// and matte exists (`mattes` empty: none is read), and the mattes have the
+// captured size.
 void check_views(const std::vector<const Candidate*>& frames, const Inputs& in, const fs::path& mattes,
                  ThreadPool& pool) {
   const size_t n = in.rig.cameras.size();
@@ -171,6 +184,7 @@ void check_views(const std::vector<const Candidate*>& frames, const Inputs& in, 
     const Camera& camera = in.rig.cameras[static_cast<size_t>(i) % n];
     const fs::path image = f.take->image_path(camera.name, f.tracked.frame);
     if (!fs::exists(image)) throw Error(image, "is missing (" + view_name(f, camera.name) + ")");
+    if (mattes.empty()) return;
     const fs::path matte = matte_path(mattes, f, camera.name);
     if (!fs::exists(matte)) throw Error(matte, "is missing (the matte of " + view_name(f, camera.name) + "; run tega matte)");
     check_matte(matte, read_image_header(matte), camera.width, camera.height);
@@ -204,7 +218,7 @@ DatasetBuildSummary build_dataset(const DatasetBuildRequest& request, const Data
   }
 
   DatasetBuildOptions resume_options = options;
-  resume_options.threads = 0;  // the output does not depend on it
+  resume_options.threads = resume_options.matte.threads = 0;  // the output does not depend on them
   StagedDirectory staged(request.out, request.replace_existing, options_to_yaml(resume_options) + in.fingerprint);
   dataset.root = staged.path();
 
@@ -233,15 +247,22 @@ DatasetBuildSummary build_dataset(const DatasetBuildRequest& request, const Data
       }
     }
     if (to_write.empty()) continue;
-    // Once per camera: at 6144 x 4096 the maps take 200 MB and a second to make.
-    const std::unique_ptr<UndistortionMaps> maps =
-        captured.has_distortion() ? std::make_unique<UndistortionMaps>(captured.undistortion_maps()) : nullptr;
+    // Once per camera: at 6144 x 4096 the maps take a second to make.
+    const DatasetResampler resampler(captured, options.downsample);
+    std::optional<CameraMatting> matting;
+    if (request.mattes.empty())
+      matting.emplace(captured,
+                      in.clean_plate ? read_recorded_rgb(*in.clean_plate, camera, 0, captured.width, captured.height)
+                                     : Image8(),
+                      options.matte);
     pool.parallel_for(0, static_cast<int64_t>(to_write.size()), [&](int64_t i) {
       const Candidate& f = *to_write[static_cast<size_t>(i)];
       const Image8 rgb = read_recorded_rgb(*f.take, camera, f.tracked.frame, captured.width, captured.height);
       const Image8 matte =
-          read_matte(matte_path(request.mattes, f, camera), captured.width, captured.height, view_name(f, camera));
-      const Image8 rgba = dataset_rgba(rgb, matte, maps.get(), options.downsample);
+          matting ? matting->matte(rgb, read_vertices_bin(f.tracked.mesh, vertices), dataset.template_mesh.faces)
+                  : read_matte(matte_path(request.mattes, f, camera), captured.width, captured.height,
+                               view_name(f, camera));
+      const Image8 rgba = resampler.rgba(rgb, matte);
       write_png_view({rgba.pixels.data(), rgba.width, rgba.height, 4, 8, static_cast<size_t>(rgba.width) * 4},
                      dataset.image_path(camera, f.id()), options.png_compression);
       progress.advance();

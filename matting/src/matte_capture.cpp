@@ -6,14 +6,13 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "clean_plate.h"
 #include "recorded_image.h"
 #include "tega/core/error.h"
 #include "tega/core/files.h"
-#include "tega/core/log.h"
 #include "tega/core/options.h"
 #include "tega/core/progress.h"
 #include "tega/core/rig.h"
-#include "tega/core/silhouette.h"
 #include "tega/core/take.h"
 #include "tega/core/thread_pool.h"
 #include "tega/matting/matte.h"
@@ -28,31 +27,6 @@ std::string frame_name(int frame) {
   char name[16];
   std::snprintf(name, sizeof name, "%06d", frame);
   return name;
-}
-
-// The capture's clean plate take, or none (with a warning).
-std::optional<TakeInfo> clean_plate_take(const CaptureInfo& capture, const MatteOptions& options) {
-  if (!options.use_clean_plate) return std::nullopt;
-  std::string name = options.clean_plate_take;
-  if (name.empty())
-    for (const auto& take : capture.takes)
-      if (take.kind == "clean_plate") name = take.name;
-  if (name.empty()) {
-    logging::warn("matte: %s has no clean_plate take: mattes come from the tracked mesh alone, without hair and "
-                  "with a soft edge", capture.root.c_str());
-    return std::nullopt;
-  }
-  TakeInfo take = read_take(capture.root / "takes" / name);
-  if (take.kind != "clean_plate")
-    throw Error(take.folder / "take.json", "is a " + take.kind + " take, not a clean plate (matte.clean_plate_take)");
-  return take;
-}
-
-// MatteOptions::MeshPriorOptions::margin_m in pixels: at the mesh's depth in this camera.
-double margin_in_pixels(const Camera& camera, const Vertices& world, double margin_m) {
-  const Eigen::Vector3d centre = world.colwise().mean().transpose().cast<double>();
-  const double depth = camera.world_to_camera.apply(centre).z();
-  return depth > 0 ? camera.K(0, 0) * margin_m / depth : 0;
 }
 
 struct TakeJob {
@@ -117,8 +91,9 @@ MatteSummary matte_capture(const MatteRequest& request, const MatteOptions& opti
       const Camera& camera = rig.camera(camera_name);
       const fs::path dir = job.out / camera_name;
       fs::create_directories(dir);
-      Image8 plate;
-      if (plate_take) plate = read_recorded_rgb(*plate_take, camera_name, 0, camera.width, camera.height);
+      const CameraMatting matting(
+          camera, plate_take ? read_recorded_rgb(*plate_take, camera_name, 0, camera.width, camera.height) : Image8(),
+          options);
       pool.parallel_for(0, int64_t(tracked.size()), [&](int64_t i) {
         const tracking::TrackedFrame& frame = *tracked[size_t(i)];
         const fs::path file = dir / (frame_name(frame.frame) + ".png");
@@ -129,10 +104,7 @@ MatteSummary matte_capture(const MatteRequest& request, const MatteOptions& opti
         }
         const Image8 photo = read_recorded_rgb(job.take, camera_name, frame.frame, camera.width, camera.height);
         const Vertices world = read_vertices_bin(frame.mesh, subject.neutral.num_vertices());
-        const Image8 silhouette = mesh_silhouette(camera, world, subject.neutral.faces);
-        write_image(compute_matte(photo, plate_take ? &plate : nullptr, silhouette,
-                                  margin_in_pixels(camera, world, options.mesh.margin_m), options),
-                    file);
+        write_matte(matting.matte(photo, world, subject.neutral.faces), file);
         ++done;
         progress.advance();
       });

@@ -1,12 +1,14 @@
 // One image's matte (docs/matting.md#the-method).
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/ximgproc/edge_filter.hpp>
 #include <tuple>
 #include <vector>
 
 #include "tega/core/error.h"
+#include "tega/core/silhouette.h"
 #include "tega/matting/matte.h"
 
 namespace tega::matting {
@@ -19,7 +21,7 @@ cv::Mat view_of(const Image8& image) {
 // Distance of every pixel to the nearest pixel outside `mask` (0 outside it).
 cv::Mat distance_inside(const cv::Mat& mask) {
   cv::Mat distance;
-  cv::distanceTransform(mask, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  cv::distanceTransform(mask, distance, cv::DIST_L2, cv::DIST_MASK_5);
   return distance;
 }
 cv::Mat distance_outside(const cv::Mat& mask) { return distance_inside(mask == 0); }
@@ -41,6 +43,14 @@ std::vector<cv::Point> sample_points(const cv::Mat& where, int target = 200000) 
   return points;
 }
 
+// Sums over 3 x 3 pixels (exact, in 16 bits) of an RGB image: the 3 x 3
+// means the difference is taken between, at a fraction of a float blur's cost.
+cv::Mat sums_3x3(const cv::Mat& colour) {
+  cv::Mat sums;
+  cv::boxFilter(colour, sums, CV_16U, cv::Size(3, 3), cv::Point(-1, -1), false);
+  return sums;
+}
+
 // The frame's exposure against the clean plate: a per-channel gain measured
 // on the far background, where the plate and the frame show the same thing.
 cv::Vec3f exposure_gain(const cv::Mat& photo, const cv::Mat& plate, const std::vector<cv::Point>& background,
@@ -49,39 +59,67 @@ cv::Vec3f exposure_gain(const cv::Mat& photo, const cv::Mat& plate, const std::v
   for (int c = 0; c < 3; ++c) {
     std::vector<float> ratios;
     for (const auto& p : background) {
-      const float b = plate.at<cv::Vec3f>(p)[c];
-      if (b > 0.04f) ratios.push_back(photo.at<cv::Vec3f>(p)[c] / b);
+      const float b = plate.at<cv::Vec3b>(p)[c];
+      if (b > 0.04f * 255) ratios.push_back(photo.at<cv::Vec3b>(p)[c] / b);
     }
     if (ratios.size() > 100) gain[c] = float(std::clamp(median_of(ratios), 1 - max_change, 1 + max_change));
   }
   return gain;
 }
 
-// The noise of a difference photo - plate, from its median absolute deviation.
-double difference_noise(const cv::Mat& difference, const std::vector<cv::Point>& background) {
+// The part of the 3 x 3 mean photo - plate that a change of shading within
+// 1 +- `shading` does not explain (a shadow on the backdrop, a passing cloud):
+// the plate scaled by the factor that best matches the photo, clamped to that
+// range, is subtracted (brightness and colour distortion, Horprasert et al.).
+// The plate is first brought to the frame's exposure by `gain`. From the
+// exact 3 x 3 sums; [0, 1] units.
+class MeanDifference {
+ public:
+  MeanDifference(const cv::Vec3f& gain, double shading)
+      : gain_(gain / (9.0f * 255)), low_(float(1 - shading)), high_(float(1 + shading)), shading_(shading > 0) {}
+  cv::Vec3f operator()(const cv::Vec3w& photo_sums, const cv::Vec3w& plate_sums) const {
+    const cv::Vec3f I(photo_sums[0] * kUnit, photo_sums[1] * kUnit, photo_sums[2] * kUnit);
+    const cv::Vec3f B(plate_sums[0] * gain_[0], plate_sums[1] * gain_[1], plate_sums[2] * gain_[2]);
+    if (!shading_) return I - B;
+    const float b2 = B.dot(B);
+    const float k = b2 > 1e-6f ? std::clamp(I.dot(B) / b2, low_, high_) : 1.0f;
+    return I - k * B;
+  }
+
+ private:
+  static constexpr float kUnit = 1.0f / (9 * 255);
+  cv::Vec3f gain_;
+  float low_, high_;
+  bool shading_;
+};
+
+// The noise of the mean difference, from its median absolute deviation on the
+// far background.
+double difference_noise(const cv::Mat& photo_sums, const cv::Mat& plate_sums, const MeanDifference& difference,
+                        const std::vector<cv::Point>& background) {
   std::vector<float> values;
   values.reserve(background.size() * 3);
-  for (const auto& p : background)
-    for (int c = 0; c < 3; ++c) values.push_back(difference.at<cv::Vec3f>(p)[c]);
+  for (const auto& p : background) {
+    const cv::Vec3f d = difference(photo_sums.at<cv::Vec3w>(p), plate_sums.at<cv::Vec3w>(p));
+    for (int c = 0; c < 3; ++c) values.push_back(d[c]);
+  }
   const float centre = float(median_of(values));
   for (float& v : values) v = std::abs(v - centre);
   return 1.4826 * median_of(values);
 }
 
-// The part of photo - plate that a change of shading within 1 +- `shading`
-// does not explain (a shadow on the backdrop, a passing cloud): per pixel,
-// the plate scaled by the factor that best matches the photo, clamped to that
-// range, is subtracted (brightness and colour distortion, Horprasert et al.).
-cv::Mat unexplained(const cv::Mat& photo, const cv::Mat& plate, double shading) {
-  if (shading <= 0) return photo - plate;
-  cv::Mat out(photo.size(), CV_32FC3);
-  const float low = float(1 - shading), high = float(1 + shading);
-  for (int y = 0; y < photo.rows; ++y) {
-    for (int x = 0; x < photo.cols; ++x) {
-      const cv::Vec3f I = photo.at<cv::Vec3f>(y, x), B = plate.at<cv::Vec3f>(y, x);
-      const float b2 = B.dot(B);
-      const float k = b2 > 1e-6f ? std::clamp(I.dot(B) / b2, low, high) : 1.0f;
-      out.at<cv::Vec3f>(y, x) = I - k * B;
+// 255 where the mean difference is longer than `threshold`.
+cv::Mat differs(const cv::Mat& photo_sums, const cv::Mat& plate_sums, const MeanDifference& difference,
+                double threshold) {
+  cv::Mat out(photo_sums.size(), CV_8U);
+  const float limit2 = float(threshold * threshold);
+  for (int y = 0; y < out.rows; ++y) {
+    const cv::Vec3w* photo = photo_sums.ptr<cv::Vec3w>(y);
+    const cv::Vec3w* plate = plate_sums.ptr<cv::Vec3w>(y);
+    uint8_t* row = out.ptr<uint8_t>(y);
+    for (int x = 0; x < out.cols; ++x) {
+      const cv::Vec3f d = difference(photo[x], plate[x]);
+      row[x] = d.dot(d) > limit2 ? 255 : 0;
     }
   }
   return out;
@@ -135,8 +173,9 @@ cv::Mat connected_subject(const cv::Mat& subject, const cv::Mat& anchor, const c
 }
 
 // Mean colour of the `known` pixels around each pixel, over ever larger
-// windows until some are found: the subject's colour just inside its edge.
-cv::Mat nearby_colour(const cv::Mat& colour, const cv::Mat& known, int radius) {
+// windows until some are found for every `needed` pixel: the subject's colour
+// just inside its edge. -1 where none was found.
+cv::Mat nearby_colour(const cv::Mat& colour, const cv::Mat& known, const cv::Mat& needed, int radius) {
   cv::Mat weight;
   known.convertTo(weight, CV_32F, 1.0 / 255);
   cv::Mat weighted;
@@ -148,10 +187,19 @@ cv::Mat nearby_colour(const cv::Mat& colour, const cv::Mat& known, int radius) {
     cv::Mat sum, total;
     cv::boxFilter(weighted, sum, -1, cv::Size(2 * r + 1, 2 * r + 1), cv::Point(-1, -1), false);
     cv::boxFilter(weight, total, -1, cv::Size(2 * r + 1, 2 * r + 1), cv::Point(-1, -1), false);
-    for (int y = 0; y < colour.rows; ++y)
-      for (int x = 0; x < colour.cols; ++x)
-        if (result.at<cv::Vec3f>(y, x)[0] < 0 && total.at<float>(y, x) > 0.5f)
-          result.at<cv::Vec3f>(y, x) = sum.at<cv::Vec3f>(y, x) / total.at<float>(y, x);
+    bool missing = false;
+    for (int y = 0; y < colour.rows; ++y) {
+      cv::Vec3f* out = result.ptr<cv::Vec3f>(y);
+      const cv::Vec3f* sums = sum.ptr<cv::Vec3f>(y);
+      const float* totals = total.ptr<float>(y);
+      const uint8_t* need = needed.ptr<uint8_t>(y);
+      for (int x = 0; x < colour.cols; ++x) {
+        if (out[x][0] >= 0) continue;
+        if (totals[x] > 0.5f) out[x] = sums[x] / totals[x];
+        else if (need[x]) missing = true;
+      }
+    }
+    if (!missing) break;
   }
   return result;
 }
@@ -193,48 +241,55 @@ Image8 resized(const Image8& image, int width, int height, int interpolation) {
   return out;
 }
 
+// A clean plate at the size photos are matted at, with its 3 x 3 sums.
+struct Plate {
+  cv::Mat colour;  // CV_8UC3
+  cv::Mat sums;    // CV_16UC3
+};
+
+Plate plate_of(const Image8& image) { return {view_of(image), sums_3x3(view_of(image))}; }
+
 // What unmixing needs, kept from a matte made at a smaller size to unmix the
 // full-size photo's edge.
 struct EdgeModel {
   cv::Vec3f gain{1, 1, 1};  // exposure of the frame against the clean plate
-  cv::Mat subject_colour;   // CV_32FC3, the subject's colour near its edge; -1 where unknown
+  cv::Rect roi;             // where the edge lies, in the small image
+  cv::Mat subject_colour;   // CV_32FC3 over roi, the subject's colour near its edge; -1 where unknown
 };
 
-Image8 matte_at_this_size(const Image8& photo, const Image8* clean_plate, const Image8& silhouette, double margin_px,
+Image8 matte_at_this_size(const Image8& photo, const Plate* plate, const Image8& silhouette, double margin_px,
                           const MatteOptions& options, EdgeModel* edge_model = nullptr) {
   const cv::Mat photo8 = view_of(photo), mesh = view_of(silhouette);
   const int margin = std::max(1, int(std::lround(margin_px)));
-  if (!clean_plate) return mesh_only_matte(photo8, mesh, margin, options);
+  if (!plate) return mesh_only_matte(photo8, mesh, margin, options);
 
-  const cv::Mat inside_mesh = distance_inside(mesh), outside_mesh = distance_outside(mesh);
-  const cv::Mat certain = inside_mesh > margin;  // subject whatever the plate says
-  const cv::Mat possible = outside_mesh <= margin;
   const int band = std::max(1, options.edge.band_px);
-  const std::vector<cv::Point> far = sample_points(outside_mesh > margin + 4 * band);
+  // Distances to the mesh's outline matter within `reach` of it; the rest of
+  // the photo is far background.
+  cv::Mat certain(photo8.size(), CV_8U, cv::Scalar(0));  // subject whatever the plate says
+  cv::Mat possible(photo8.size(), CV_8U, cv::Scalar(0));
+  cv::Mat far_mask(photo8.size(), CV_8U, cv::Scalar(255));
+  const int reach = margin + 4 * band + 2;
+  const cv::Rect near_mesh = grown(cv::boundingRect(mesh), reach, photo8.size());
+  if (near_mesh.area() > 0) {
+    const cv::Mat inside = distance_inside(mesh(near_mesh)), outside = distance_outside(mesh(near_mesh));
+    cv::Mat(inside > margin).copyTo(certain(near_mesh));
+    cv::Mat(outside <= margin).copyTo(possible(near_mesh));
+    cv::Mat(outside > margin + 4 * band).copyTo(far_mask(near_mesh));
+  }
+  const std::vector<cv::Point> far = sample_points(far_mask);
 
-  cv::Mat image, plate;
-  photo8.convertTo(image, CV_32FC3, 1.0 / 255);
-  view_of(*clean_plate).convertTo(plate, CV_32FC3, 1.0 / 255);
-  const cv::Vec3f gain = exposure_gain(image, plate, far, options.difference.max_exposure_change);
-  cv::multiply(plate, cv::Scalar(gain[0], gain[1], gain[2]), plate);
+  const cv::Vec3f gain = exposure_gain(photo8, plate->colour, far, options.difference.max_exposure_change);
   // Subject: where the 3x3 mean difference stands out of that mean's noise,
   // measured on the far background (real noise is correlated: a third of one
   // pixel's would be too optimistic), cleaned, joined with the certain head,
   // its holes filled.
-  const double shading = options.difference.shading_tolerance;
-  cv::Mat image_mean, plate_mean;
-  cv::blur(image, image_mean, cv::Size(3, 3));
-  cv::blur(plate, plate_mean, cv::Size(3, 3));
-  const cv::Mat mean_difference = unexplained(image_mean, plate_mean, shading);
-  const double noise = options.difference.noise_sigma > 0 ? options.difference.noise_sigma / 3
-                                                          : std::max(3e-4, difference_noise(mean_difference, far));
-  cv::Mat squared;
-  cv::multiply(mean_difference, mean_difference, squared);
-  cv::Mat distance2 = squared.reshape(1, int(squared.total())).clone();
-  cv::reduce(distance2, distance2, 1, cv::REDUCE_SUM);
-  distance2 = distance2.reshape(1, image.rows);
-  const double threshold = options.difference.subject_sigmas * noise;
-  cv::Mat subject = distance2 > threshold * threshold;
+  const cv::Mat photo_sums = sums_3x3(photo8);
+  const MeanDifference difference(gain, options.difference.shading_tolerance);
+  const double noise = options.difference.noise_sigma > 0
+                           ? options.difference.noise_sigma / 3
+                           : std::max(3e-4, difference_noise(photo_sums, plate->sums, difference, far));
+  cv::Mat subject = differs(photo_sums, plate->sums, difference, options.difference.subject_sigmas * noise);
   if (options.difference.open_px > 0) cv::morphologyEx(subject, subject, cv::MORPH_OPEN, disk(options.difference.open_px));
   if (options.difference.close_px > 0) cv::morphologyEx(subject, subject, cv::MORPH_CLOSE, disk(options.difference.close_px));
   subject |= certain;
@@ -248,15 +303,14 @@ Image8 matte_at_this_size(const Image8& photo, const Image8* clean_plate, const 
   subject.convertTo(alpha, CV_32F, 1.0 / 255);
   const cv::Rect box = cv::boundingRect(band_mask);
   if (box.area() == 0) return image_of(alpha);
-  const cv::Rect roi = grown(box, 8 * (2 * band + 1), image.size());
+  const cv::Rect roi = grown(box, 8 * (2 * band + 1), photo8.size());
   const cv::Mat in_band = band_mask(roi), known_subject = subject(roi) & (in_band == 0);
-  const cv::Mat colour = image(roi), background = plate(roi);
-  const cv::Mat subject_colour = nearby_colour(colour, known_subject, 2 * band + 1);
-  if (edge_model) {
-    edge_model->gain = gain;
-    edge_model->subject_colour = cv::Mat(image.size(), CV_32FC3, cv::Scalar::all(-1));
-    subject_colour.copyTo(edge_model->subject_colour(roi));
-  }
+  cv::Mat colour, background;
+  photo8(roi).convertTo(colour, CV_32FC3, 1.0 / 255);
+  plate->colour(roi).convertTo(background, CV_32FC3, 1.0 / 255);
+  cv::multiply(background, cv::Scalar(gain[0], gain[1], gain[2]), background);
+  const cv::Mat subject_colour = nearby_colour(colour, known_subject, in_band, 2 * band + 1);
+  if (edge_model) *edge_model = {gain, roi, subject_colour};
   cv::Mat smooth_mask;
   cv::blur(alpha(roi), smooth_mask, cv::Size(3, 3));
 
@@ -277,9 +331,12 @@ Image8 matte_at_this_size(const Image8& photo, const Image8* clean_plate, const 
   }
   if (options.edge.guided_filter_radius_px > 0) {
     cv::Mat filtered;
-    cv::ximgproc::guidedFilter(photo8(roi), unmixed, filtered, options.edge.guided_filter_radius_px,
+    // Band pixels see 2 radii around them: the filter runs on the band's box grown by that.
+    const cv::Rect near_band = grown(box, 2 * options.edge.guided_filter_radius_px + 1, photo8.size());
+    const cv::Rect within_roi = near_band - roi.tl();
+    cv::ximgproc::guidedFilter(photo8(near_band), unmixed(within_roi), filtered, options.edge.guided_filter_radius_px,
                                options.edge.guided_filter_eps);
-    filtered.copyTo(unmixed, in_band);
+    filtered.copyTo(unmixed(within_roi), in_band(within_roi));
   }
   cv::Mat target = alpha(roi);
   unmixed.copyTo(target, in_band);
@@ -297,8 +354,8 @@ void unmix_enlarged_edge(const Image8& photo, const Image8& plate, const EdgeMod
   const float contrast2 = float(options.edge.min_contrast * options.edge.min_contrast);
   const auto subject_colour_at = [&](int x, int y) {
     // Bilinear in the small image, whose pixel centres lie at (i + 0.5) * shrink.
-    const float fx = std::clamp((x + 0.5f) / shrink - 0.5f, 0.0f, float(colour.cols - 1));
-    const float fy = std::clamp((y + 0.5f) / shrink - 0.5f, 0.0f, float(colour.rows - 1));
+    const float fx = std::clamp((x + 0.5f) / shrink - 0.5f - edge.roi.x, 0.0f, float(colour.cols - 1));
+    const float fy = std::clamp((y + 0.5f) / shrink - 0.5f - edge.roi.y, 0.0f, float(colour.rows - 1));
     const int x0 = int(fx), y0 = int(fy), x1 = std::min(x0 + 1, colour.cols - 1), y1 = std::min(y0 + 1, colour.rows - 1);
     const float tx = fx - x0, ty = fy - y0;
     cv::Vec3f sum(0, 0, 0);
@@ -312,8 +369,11 @@ void unmix_enlarged_edge(const Image8& photo, const Image8& plate, const EdgeMod
     }
     return weight > 0 ? cv::Vec3f(sum / weight) : cv::Vec3f(-1, -1, -1);
   };
-  for (int y = 0; y < photo.height; ++y) {
-    for (int x = 0; x < photo.width; ++x) {
+  // Outside the edge's box the small alpha is 0 or 1, and so the enlarged.
+  const int x_end = std::min(photo.width, (edge.roi.x + edge.roi.width) * shrink);
+  const int y_end = std::min(photo.height, (edge.roi.y + edge.roi.height) * shrink);
+  for (int y = edge.roi.y * shrink; y < y_end; ++y) {
+    for (int x = edge.roi.x * shrink; x < x_end; ++x) {
       uint8_t& a = alpha.at(x, y, 0);
       if (a == 0 || a == 255) continue;
       const cv::Vec3f F = subject_colour_at(x, y);
@@ -328,29 +388,94 @@ void unmix_enlarged_edge(const Image8& photo, const Image8& plate, const EdgeMod
   }
 }
 
+// The photo's matte at 1/shrink of its size, enlarged back, its edge unmixed
+// again at full size; `small_silhouette` and `small_plate` have that size.
+Image8 shrunk_matte(const Image8& photo, const Image8* clean_plate, const Plate* small_plate,
+                    const Image8& small_silhouette, int shrink, double margin_px, const MatteOptions& options) {
+  EdgeModel edge;
+  const Image8 small_alpha =
+      matte_at_this_size(resized(photo, small_silhouette.width, small_silhouette.height, cv::INTER_AREA), small_plate,
+                         small_silhouette, margin_px / shrink, options, &edge);
+  Image8 alpha = resized(small_alpha, photo.width, photo.height, cv::INTER_LINEAR);
+  if (clean_plate && !edge.subject_colour.empty()) unmix_enlarged_edge(photo, *clean_plate, edge, shrink, options, alpha);
+  return alpha;
+}
+
+// Large photos are matted at 1/shrink of their size (area-averaged) and the
+// alpha enlarged back: the time falls with the square of the factor.
+int shrink_for(int width, const MatteOptions& options) {
+  return (width + options.max_work_width - 1) / std::max(1, options.max_work_width);
+}
+
+bool same_size(const Image8& a, int width, int height) { return a.width == width && a.height == height; }
+
+// MatteOptions::MeshPriorOptions::margin_m in pixels: at the mesh's depth in this camera.
+double margin_in_pixels(const Camera& camera, const Vertices& world, double margin_m) {
+  const Eigen::Vector3d centre = world.colwise().mean().transpose().cast<double>();
+  const double depth = camera.world_to_camera.apply(centre).z();
+  return depth > 0 ? camera.K(0, 0) * margin_m / depth : 0;
+}
+
 }  // namespace
 
 Image8 compute_matte(const Image8& photo, const Image8* clean_plate, const Image8& silhouette, double margin_px,
                      const MatteOptions& options) {
   if (photo.channels != 3) throw Error("compute_matte: the photo must be RGB");
-  const auto same_size = [&](const Image8& other) { return other.width == photo.width && other.height == photo.height; };
-  if (!same_size(silhouette) || silhouette.channels != 1 || (clean_plate && (!same_size(*clean_plate) || clean_plate->channels != 3)))
+  if (!same_size(silhouette, photo.width, photo.height) || silhouette.channels != 1 ||
+      (clean_plate && (!same_size(*clean_plate, photo.width, photo.height) || clean_plate->channels != 3)))
     throw Error("compute_matte: the photo, its clean plate and the mesh silhouette differ in size");
-  const int shrink = (photo.width + options.max_work_width - 1) / std::max(1, options.max_work_width);
-  if (shrink <= 1) return matte_at_this_size(photo, clean_plate, silhouette, margin_px, options);
-  // Large photos are matted at 1/shrink of their size (area-averaged) and the
-  // alpha enlarged back: the time falls with the square of the factor.
+  const int shrink = shrink_for(photo.width, options);
+  if (shrink <= 1) {
+    const std::optional<Plate> plate = clean_plate ? std::optional(plate_of(*clean_plate)) : std::nullopt;
+    return matte_at_this_size(photo, plate ? &*plate : nullptr, silhouette, margin_px, options);
+  }
   const int width = photo.width / shrink, height = photo.height / shrink;
   Image8 small_silhouette = resized(silhouette, width, height, cv::INTER_AREA);
   for (auto& p : small_silhouette.pixels) p = p >= 128 ? 255 : 0;
   const Image8 small_plate = clean_plate ? resized(*clean_plate, width, height, cv::INTER_AREA) : Image8();
-  EdgeModel edge;
-  const Image8 small_alpha = matte_at_this_size(resized(photo, width, height, cv::INTER_AREA),
-                                                clean_plate ? &small_plate : nullptr, small_silhouette,
-                                                margin_px / shrink, options, &edge);
-  Image8 alpha = resized(small_alpha, photo.width, photo.height, cv::INTER_LINEAR);
-  if (clean_plate && !edge.subject_colour.empty()) unmix_enlarged_edge(photo, *clean_plate, edge, shrink, options, alpha);
-  return alpha;
+  const std::optional<Plate> plate = clean_plate ? std::optional(plate_of(small_plate)) : std::nullopt;
+  return shrunk_matte(photo, clean_plate, plate ? &*plate : nullptr, small_silhouette, shrink, margin_px, options);
+}
+
+CameraMatting::CameraMatting(const Camera& camera, Image8 clean_plate, const MatteOptions& options)
+    : camera_(camera), work_camera_(camera), shrink_(shrink_for(camera.width, options)),
+      plate_(std::move(clean_plate)), options_(options) {
+  if (!plate_.pixels.empty() && (!same_size(plate_, camera.width, camera.height) || plate_.channels != 3))
+    throw Error("camera " + camera.name + ": its clean plate is " + std::to_string(plate_.width) + "x" +
+                std::to_string(plate_.height) + "x" + std::to_string(plate_.channels) + ", not the camera's " +
+                std::to_string(camera.width) + "x" + std::to_string(camera.height) + " RGB");
+  if (shrink_ > 1) {
+    // The size compute_matte shrinks to; the intrinsics scale by exactly 1/shrink.
+    work_camera_ = camera.scaled(1.0 / shrink_);
+    work_camera_.width = camera.width / shrink_;
+    work_camera_.height = camera.height / shrink_;
+    if (!plate_.pixels.empty()) work_plate_ = resized(plate_, work_camera_.width, work_camera_.height, cv::INTER_AREA);
+  }
+  if (plate_.pixels.empty()) return;
+  work_plate_sums_ = Image16(work_plate().width, work_plate().height, 3);
+  sums_3x3(view_of(work_plate()))
+      .copyTo(cv::Mat(work_plate_sums_.height, work_plate_sums_.width, CV_16UC3, work_plate_sums_.pixels.data()));
+}
+
+Image8 CameraMatting::matte(const Image8& photo, const Vertices& world, const Triangles& faces) const {
+  if (photo.channels != 3 || !same_size(photo, camera_.width, camera_.height))
+    throw Error("camera " + camera_.name + ": the photo is " + std::to_string(photo.width) + "x" +
+                std::to_string(photo.height) + "x" + std::to_string(photo.channels) + ", not the camera's " +
+                std::to_string(camera_.width) + "x" + std::to_string(camera_.height) + " RGB");
+  const double margin_px = margin_in_pixels(camera_, world, options_.mesh.margin_m);
+  const Image8* plate = plate_.pixels.empty() ? nullptr : &plate_;
+  const Plate work{view_of(work_plate()), cv::Mat(work_plate_sums_.height, work_plate_sums_.width, CV_16UC3,
+                                                  const_cast<uint16_t*>(work_plate_sums_.pixels.data()))};
+  // The silhouette is rasterised at the working size directly: at 26
+  // megapixels the full-size raster costs more than the matte it feeds.
+  const Image8 silhouette = mesh_silhouette(work_camera_, world, faces);
+  if (shrink_ <= 1) return matte_at_this_size(photo, plate ? &work : nullptr, silhouette, margin_px, options_);
+  return shrunk_matte(photo, plate, plate ? &work : nullptr, silhouette, shrink_, margin_px, options_);
+}
+
+void write_matte(const Image8& alpha, const std::filesystem::path& file) {
+  if (alpha.channels != 1) throw Error(file, "a matte has one channel, not " + std::to_string(alpha.channels));
+  write_png_view({alpha.pixels.data(), alpha.width, alpha.height, 1, 8, size_t(alpha.width)}, file, 1);
 }
 
 }  // namespace tega::matting

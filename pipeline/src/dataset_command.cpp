@@ -47,7 +47,9 @@ void add_build_command(CLI::App& dataset) {
                "(docs/matting.md#building-the-dataset).");
   build->add_option("--capture", args->request.capture, "The capture: CAPTURE/ with capture.json, rig.json, takes/.");
   build->add_option("--tracked", args->request.tracked, "TRACKED/ from tega track.");
-  build->add_option("--mattes", args->request.mattes, "MATTES/ from tega matte.");
+  build->add_option("--mattes", args->request.mattes,
+                    "MATTES/ from tega matte. Without it, the sampled images are matted here with the options' "
+                    "`matte` section (the same method; each photo is decoded once).");
   build->add_option("--out", args->request.out,
                     "Dataset directory to write; appears only once complete (an interrupted run leaves "
                     "OUT.partial/, which the same command continues).");
@@ -60,8 +62,8 @@ void add_build_command(CLI::App& dataset) {
     const auto options = load_stage_options<matting::DatasetBuildOptions>(args->config, "dataset", args->overrides);
     if (args->print_options) return print_stage_options("dataset", options);
     const auto& r = args->request;
-    if (r.capture.empty() || r.tracked.empty() || r.mattes.empty() || r.out.empty())
-      throw Error("tega dataset build: --capture, --tracked, --mattes and --out are required");
+    if (r.capture.empty() || r.tracked.empty() || r.out.empty())
+      throw Error("tega dataset build: --capture, --tracked and --out are required");
     const auto s = matting::build_dataset(r, options);
     std::cout << s.dataset.string() << ": " << s.train_frames << " train + " << s.test_frames << " test frames, "
               << s.train_cameras.size() << " train + " << s.test_cameras.size() << " test cameras, " << s.images

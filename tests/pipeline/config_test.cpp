@@ -120,6 +120,20 @@ TEST(StageGraph, OrdersStagesDependenciesFirstAndFindsArtifacts) {
   EXPECT_EQ(g.upstream_of({false, true, false}), (std::vector<bool>{true, true, false}));
 }
 
+TEST(StageGraph, TheDatasetTakesMattesOnlyWhereAMatteStageIsUpstream) {
+  const std::string chain = "workspace: ws\nstages:\n  capture:\n  calibrate: {after: capture}\n"
+                            "  mvs: {after: calibrate}\n  track: {after: mvs}\n";
+  const StageGraph without(parse(chain + "  dataset: {after: track}\n"), all_commands);
+  const Stage& dataset = without.stages().back();
+  ASSERT_EQ(dataset.name(), "dataset");
+  EXPECT_FALSE(dataset.artifact_source.count("mattes"));
+  EXPECT_EQ(dataset.artifact_source.at("tracked"), 3u);
+
+  const StageGraph with(parse(chain + "  matte: {after: track}\n  dataset: {after: matte}\n"), all_commands);
+  ASSERT_EQ(with.stages().back().name(), "dataset");
+  EXPECT_EQ(with.stages().back().artifact_source.at("mattes"), 4u);
+}
+
 TEST(StageGraph, RejectsUnknownKindsCyclesAndMissingArtifacts) {
   EXPECT_NE(error_of([] { StageGraph(parse("workspace: ws\nstages: {x: {kind: sinth}}\n"), all_commands); })
                 .find("stage 'x': unknown kind 'sinth'; known kinds: synth, ingest_multiface, dataset_check"),

@@ -226,9 +226,10 @@ TEST(TegaRun, StagesTheBuildLacksAreReportedNotFaked) {
   const fs::path config = fs::path(TEGA_STUDIO_CONFIGS) / "studio13-capture.yaml";
   const auto r = run_tega({"run", config.string(), "--workspace", (dir / "ws").string()}, dir.path());
   EXPECT_EQ(r.exit_code, 1) << r.output;
-  const bool has_matte = tega_has_command({"matte"});
-  if (!has_matte) {
-    EXPECT_NE(r.output.find("matte/default unavailable: `tega matte` is not available in this build"), std::string::npos)
+  const bool has_dataset_build = tega_has_command({"dataset", "build"});
+  if (!has_dataset_build) {
+    EXPECT_NE(r.output.find("dataset/default unavailable: `tega dataset build` is not available in this build"),
+              std::string::npos)
         << r.output;
   }
   EXPECT_NE(r.output.find("0 shard(s) ran"), std::string::npos) << r.output;
@@ -236,10 +237,8 @@ TEST(TegaRun, StagesTheBuildLacksAreReportedNotFaked) {
   for (const auto& stage : status["stages"]) {
     if (stage["kind"] == "train") {
       EXPECT_EQ(stage["shards"][0]["state"], stage["available"] ? "pending" : "unavailable");
-    } else if (stage["kind"] == "matte") {
-      EXPECT_EQ(stage["available"], has_matte) << stage;
     } else if (stage["kind"] == "dataset") {
-      EXPECT_EQ(stage["available"], tega_has_command({"dataset", "build"})) << stage;
+      EXPECT_EQ(stage["available"], has_dataset_build) << stage;
     } else if (stage["kind"] != "eval" && stage["kind"] != "render") {
       EXPECT_TRUE(stage["available"]) << stage;  // capture runs, and fails: this machine has no studio cameras
     }

@@ -93,7 +93,7 @@ StageGraph::StageGraph(PipelineConfig config, const CommandAvailable& available)
 
   for (Stage& stage : stages_) {
     // Each artifact comes from the nearest stage upstream that provides it.
-    for (const auto& artifact : stage.kind->needs) {
+    const auto find_source = [&](const std::string& artifact) {
       std::deque<size_t> queue(stage.upstream.begin(), stage.upstream.end());
       std::set<size_t> seen;
       while (!queue.empty()) {
@@ -102,10 +102,14 @@ StageGraph::StageGraph(PipelineConfig config, const CommandAvailable& available)
         if (!seen.insert(s).second) continue;
         if (stages_[s].kind->provides.count(artifact)) {
           stage.artifact_source[artifact] = s;
-          break;
+          return;
         }
         queue.insert(queue.end(), stages_[s].upstream.begin(), stages_[s].upstream.end());
       }
+    };
+    for (const auto& artifact : stage.kind->optional_needs) find_source(artifact);
+    for (const auto& artifact : stage.kind->needs) {
+      find_source(artifact);
       if (!stage.artifact_source.count(artifact)) {
         throw Error(source, "stage '" + stage.name() + "' (kind " + stage.kind->name + ") needs a " + artifact +
                                 ", which none of the stages it comes after provides (list one in its 'after')");

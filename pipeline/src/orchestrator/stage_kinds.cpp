@@ -186,20 +186,24 @@ std::vector<StageKind> make_stage_kinds() {
   };
   kinds.push_back(matte);
   // The trainer's dataset: sampled frames, undistorted and downsampled RGBA
-  // images; resumes from the images an interrupted shard wrote.
+  // images, matted by a matte stage upstream or, without one, here (the
+  // sampled images alone); resumes from the images an interrupted shard wrote.
   StageKind dataset;
   dataset.name = "dataset";
   dataset.summary = "assembles the dataset from the capture, its tracked meshes and mattes (tega dataset build)";
   dataset.subcommand = {"dataset", "build"};
-  dataset.needs = {"capture", "rig", "tracked", "mattes"};
+  dataset.needs = {"capture", "rig", "tracked"};
+  dataset.optional_needs = {"mattes"};
   dataset.provides = {{"dataset", "dataset"}};
   dataset.options_section = "dataset";
   dataset.resumes_in_staging = true;
   dataset.arguments = [](const ShardPaths& p) {
-    return with_config({"--capture", p.artifacts.at("capture").string(), "--rig", p.artifacts.at("rig").string(),
-                        "--tracked", p.artifacts.at("tracked").string(), "--mattes",
-                        p.artifacts.at("mattes").string(), "--out", (p.output / "dataset").string()},
-                       p);
+    std::vector<std::string> arguments{"--capture", p.artifacts.at("capture").string(),
+                                       "--rig",     p.artifacts.at("rig").string(),
+                                       "--tracked", p.artifacts.at("tracked").string(),
+                                       "--out",     (p.output / "dataset").string()};
+    if (p.artifacts.count("mattes")) arguments.insert(arguments.end(), {"--mattes", p.artifacts.at("mattes").string()});
+    return with_config(arguments, p);
   };
   kinds.push_back(dataset);
   return kinds;

@@ -1,6 +1,7 @@
 #pragma once
 // `tega dataset build`: the trainer's dataset (docs/layouts.md#dataset) from a
-// capture, what `tega track` made of it and what `tega matte` made of it
+// capture, what `tega track` made of it and its mattes: those `tega matte`
+// made, or made here for the sampled images alone
 // (docs/matting.md#building-the-dataset). Each image is undistorted to the
 // rig's pinhole, downsampled by area and written as RGBA with its matte as
 // alpha; the frames are sampled uniformly over the performance takes.
@@ -8,6 +9,8 @@
 #include <filesystem>
 #include <string>
 #include <vector>
+
+#include "tega/matting/matte_options.h"
 
 namespace tega::matting {
 
@@ -19,6 +22,7 @@ struct DatasetBuildOptions {
   int test_camera_count = 2;
   int png_compression = 1;
   int threads = 0;
+  MatteOptions matte;  // without a MATTES folder; its `threads` is not used
 
   template <class V>
   void visit(V& v) {
@@ -40,13 +44,19 @@ struct DatasetBuildOptions {
       "zlib level of the images (0-9): 1 writes several times faster than 6 for files about 10% larger "
       "(docs/matting.md#storage).");
     v("threads", threads, "Worker threads; 0 = one per hardware thread.");
+    v("matte", matte,
+      "How the images are matted when no folder of tega matte's mattes is given (the same method and options as "
+      "tega matte; matte.threads is not used): each sampled image is matted as it is built, its photo decoded "
+      "once.");
   }
 };
 
 struct DatasetBuildRequest {
   std::filesystem::path capture;  // CAPTURE/: capture.json, rig.json, takes/
   std::filesystem::path tracked;  // TRACKED/ from tega track
-  std::filesystem::path mattes;   // MATTES/ from tega matte: <take>/<camera>/<frame:06d>.png, <take>/mattes.json
+  // MATTES/ from tega matte: <take>/<camera>/<frame:06d>.png, <take>/mattes.json;
+  // empty: the images are matted here (DatasetBuildOptions::matte).
+  std::filesystem::path mattes;
   std::filesystem::path out;      // DATASET/
   std::filesystem::path rig;      // empty: the capture's rig file
   bool replace_existing = false;  // an existing DATASET/ is an error otherwise

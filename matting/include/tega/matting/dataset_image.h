@@ -3,6 +3,7 @@
 // trainer's RGBA (docs/matting.md#building-the-dataset).
 
 #include <filesystem>
+#include <opencv2/core.hpp>
 #include <string>
 
 #include "tega/core/camera.h"
@@ -19,10 +20,23 @@ void check_matte(const std::filesystem::path& file, const ImageHeader& header, i
 // it mattes.
 Image8 read_matte(const std::filesystem::path& file, int width, int height, const std::string& what);
 
-// The captured colour with `matte` as alpha, resampled together: undistorted
-// through `maps` (null: the camera has no distortion), then shrunk by
-// `downsample` by block averaging. Colour and alpha go through the same
-// resampling so that the edges line up.
-Image8 dataset_rgba(const Image8& rgb, const Image8& matte, const UndistortionMaps* maps, int downsample);
+// The captured colour of one camera with its matte as alpha, resampled
+// together so that the edges line up: undistorted, then shrunk by
+// `downsample` by block averaging. The same result as core's
+// undistort_image(rgba, maps, downsample) up to OpenCV's fixed-point
+// interpolation (1/32 pixel, one level of rounding), several times faster:
+// OpenCV's vectorised remap and area resize, a strip of rows at a time so
+// that the full-size intermediate stays in cache. Made once per camera (the
+// maps take a second at 26 megapixels); rgba() is thread-safe.
+class DatasetResampler {
+ public:
+  // Throws tega::Error unless `downsample` divides the camera's size.
+  DatasetResampler(const Camera& captured, int downsample);
+  Image8 rgba(const Image8& rgb, const Image8& matte) const;
+
+ private:
+  int width_, height_, downsample_;
+  cv::Mat map_xy_, map_fraction_;  // OpenCV's fixed-point maps; empty without distortion
+};
 
 }  // namespace tega::matting

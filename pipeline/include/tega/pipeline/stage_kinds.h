@@ -36,6 +36,7 @@ struct StageKind {
   // the stage is not implemented in tega yet and is reported as such.
   std::vector<std::string> subcommand;
   std::vector<std::string> needs;                        // artifacts taken from upstream stages
+  std::vector<std::string> optional_needs;               // taken where a stage upstream provides them
   std::map<std::string, std::string> provides;           // artifact -> path inside the shard directory
   OptionsAs options_as = OptionsAs::config_file;
   std::string options_section;                           // config_file: the section the command reads, "" = all
