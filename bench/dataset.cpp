@@ -1,10 +1,12 @@
 // bench/dataset: images per second of the capture-to-dataset stages at the
 // paper's sizes (6144 x 4096 captured, 3072 x 2048 in the dataset) on the
 // target's 2 cores, on a virtual-studio capture it renders (rendering is not
-// timed) with its true meshes as the tracked ones: tega matte's mattes, then
-// tega dataset build on them; then, per 3072 x 2048 RGBA image, what the
+// timed) with its true meshes as the tracked ones, stored as RGB or (--bayer)
+// raw Bayer: tega matte's mattes, tega dataset build on them, and tega
+// dataset build matting the images itself (PNG, then .zst); the steps of one
+// image on one thread; then, per 3072 x 2048 RGBA image, what the
 // dataset's storage costs the trainer's loader: PNG write and read at several
-// zlib levels, and raw RGBA in zstd for comparison.
+// zlib levels, and tega's raw pixels in zstd (.zst).
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
@@ -28,9 +30,6 @@
 #include "tega/tracking/evaluation.h"
 #include "tega/tracking/tracked.h"
 
-#ifdef TEGA_BENCH_HAVE_ZSTD
-#include <zstd.h>
-#endif
 
 namespace fs = std::filesystem;
 using namespace tega;
@@ -66,19 +65,13 @@ void storage_table(const Image8& rgba, const fs::path& dir, int repeats) {
     std::printf("png level %-4d %10.2f %10.1f %10.1f %14.0f\n", level, double(fs::file_size(file)) / 1e6, 1000 * write_s,
                 1000 * read_s, megabytes / read_s);
   }
-#ifdef TEGA_BENCH_HAVE_ZSTD
-  std::vector<char> packed(ZSTD_compressBound(rgba.pixels.size()));
-  std::vector<uint8_t> unpacked(rgba.pixels.size());
   for (const int level : {1, 3}) {
-    size_t size = 0;
-    const double write_s = timed(repeats, [&] {
-      size = ZSTD_compress(packed.data(), packed.size(), rgba.pixels.data(), rgba.pixels.size(), level);
-    });
-    const double read_s = timed(repeats, [&] { ZSTD_decompress(unpacked.data(), unpacked.size(), packed.data(), size); });
-    std::printf("zstd level %-3d %10.2f %10.1f %10.1f %14.0f   (in memory: no file, no filter)\n", level,
-                double(size) / 1e6, 1000 * write_s, 1000 * read_s, megabytes / read_s);
+    const fs::path file = dir / ("level" + std::to_string(level) + ".zst");
+    const double write_s = timed(repeats, [&] { write_zstd_view(view, file, level); });
+    const double read_s = timed(repeats, [&] { read_image_u8(file); });
+    std::printf("zstd level %-3d %10.2f %10.1f %10.1f %14.0f\n", level, double(fs::file_size(file)) / 1e6,
+                1000 * write_s, 1000 * read_s, megabytes / read_s);
   }
-#endif
 }
 
 // A captured image as the stages see it: RGB, debayered where it is raw.
@@ -217,12 +210,12 @@ int main(int argc, char** argv) {
   std::printf("once per camera (s): the resampler's maps %.2f, the clean plate read and shrunk %.2f\n", resampler_s,
               plate_s);
 
-  std::printf("\n%-44s %8s %10s %10s %14s %16s\n", "run (2 threads)", "images", "seconds", "images/s",
+  std::printf("\n%-46s %8s %10s %10s %14s %16s\n", "run (2 threads)", "images", "seconds", "images/s",
               "images/s steady", "CPU s per image");
   const auto report = [&](const std::string& name, int images, double seconds, double cpu, double per_camera_s) {
     // Per-camera set-up runs on one thread while the others wait.
     const double setup = per_camera_s * double(rig.cameras.size());
-    std::printf("%-44s %8d %10.1f %10.2f %14.2f %16.2f\n", name.c_str(), images, seconds, images / seconds,
+    std::printf("%-46s %8d %10.1f %10.2f %14.2f %16.2f\n", name.c_str(), images, seconds, images / seconds,
                 images / (seconds - setup), (cpu - setup) / images);
   };
   matting::MatteOptions matte_options;
@@ -260,6 +253,19 @@ int main(int argc, char** argv) {
       if (entry.is_regular_file()) bytes += entry.file_size();
     std::printf("  %.2f MB per image\n", double(bytes) / 1e6 / one_pass.images);
     last = one_pass.dataset;
+  }
+
+  {
+    matting::DatasetBuildOptions options;
+    options.downsample = downsample;
+    options.frames = 0;
+    options.threads = threads;
+    options.image_format = "zst";
+    start = Clock::now();
+    cpu_start = cpu_seconds();
+    const auto zst = matting::build_dataset({capture, tracked, {}, work / "dataset-matted-here-zst", {}, true}, options);
+    report("tega dataset build, matting here (zst)", zst.images, seconds_since(start), cpu_seconds() - cpu_start,
+           plate_s + resampler_s);
   }
 
   matte_table(capture, tracked, first_camera);

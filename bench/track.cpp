@@ -53,6 +53,9 @@ int main(int argc, char** argv) {
   app.add_option("--threads", threads, "Worker threads (the target machine has 2 cores).");
   app.add_option("--landmarks", landmarks, "A dlib 68-point shape predictor for the landmark term.");
   app.add_flag("--no-flow", no_flow, "Track without the optical-flow term.");
+  bool detector_boxes = false;
+  app.add_flag("--detector-boxes", detector_boxes,
+               "Boxes from dlib's face detector (for dlib's own predictor) instead of around the posed model.");
   CLI11_PARSE(app, argc, argv);
 
   fs::path capture = capture_dir;
@@ -76,6 +79,7 @@ int main(int argc, char** argv) {
   tracking::Options options;
   options.threads = threads;
   options.landmarks.model = landmarks;
+  options.landmarks.detector_boxes = detector_boxes;
   options.flow.enabled = !no_flow;
   const tracking::HeadModel model = tracking::load_head_model(model_dir, options.model_metres_per_unit);
   const std::unique_ptr<tracking::LandmarkDetector> detector =

@@ -77,7 +77,7 @@ void check_split_names(const Dataset& d, const DatasetSplit& split, const char* 
 fs::path Dataset::mesh_path(const std::string& frame_id) const { return root / "meshes" / (frame_id + ".bin"); }
 
 fs::path Dataset::image_path(const std::string& camera, const std::string& frame_id) const {
-  return root / "images" / camera / (frame_id + ".png");
+  return root / "images" / camera / (frame_id + image_extension);
 }
 
 const DatasetFrame& Dataset::frame(const std::string& frame_id) const {
@@ -105,6 +105,10 @@ Dataset read_dataset(const fs::path& root) {
   d.rig = read_rig_json(root / field<std::string>(manifest, "rig", file, "the manifest"));
   d.template_mesh = read_obj(root / field<std::string>(manifest, "template", file, "the manifest"));
   if (!d.template_mesh.has_uvs()) throw Error(root / manifest["template"].get<std::string>(), "has no UVs");
+  const std::string images = manifest.value("images", std::string("images/{camera}/{frame}.png"));
+  if (images == "images/{camera}/{frame}.zst") d.image_extension = ".zst";
+  else if (images != "images/{camera}/{frame}.png")
+    throw Error(file, "names images '" + images + "'; tega reads images/{camera}/{frame}.png or .zst");
   d.eyeball_faces = manifest.value("eyeball_faces", std::vector<int32_t>{});
   d.landmark_vertices = manifest.value("landmark_vertices", std::vector<int32_t>{});
   for (int32_t f : d.eyeball_faces) {
@@ -190,7 +194,7 @@ void write_dataset_manifest(const Dataset& d) {
       {"rig", "rig.json"},
       {"template", "template.obj"},
       {"meshes", "meshes/{frame}.bin"},
-      {"images", "images/{camera}/{frame}.png"},
+      {"images", "images/{camera}/{frame}" + d.image_extension},
       {"eyeball_faces", d.eyeball_faces},
       {"landmark_vertices", d.landmark_vertices},
       {"frames", frames},

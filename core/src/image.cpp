@@ -22,6 +22,17 @@ std::string lowercase_extension(const fs::path& file) {
 }
 
 bool is_png(const fs::path& file) { return lowercase_extension(file) == ".png"; }
+bool is_zstd(const fs::path& file) { return lowercase_extension(file) == ".zst"; }
+
+PixelView view_of(const StoredImage& image, const fs::path& file) {
+  if (const auto* u8 = std::get_if<Image8>(&image))
+    return {u8->pixels.data(), u8->width, u8->height, u8->channels, 8, size_t(u8->width) * u8->channels};
+  if (const auto* u16 = std::get_if<Image16>(&image))
+    return {u16->pixels.data(), u16->width, u16->height, u16->channels, 16, size_t(u16->width) * u16->channels * 2};
+  throw Error(file, "a .zst image holds 8 or 16-bit samples, not float");
+}
+
+constexpr int kZstdLevel = 1;  // as fast to write as PNG's level 0, as small as its level 1
 
 #ifndef TEGA_HAVE_OPENIMAGEIO
 [[noreturn]] void throw_needs_oiio(const fs::path& file) {
@@ -42,6 +53,7 @@ void check_buffer(const ImageBuffer<T>& image, const fs::path& file) {
 
 StoredImage read_stored(const fs::path& file) {
   if (!fs::exists(file)) throw Error(file, "does not exist");
+  if (is_zstd(file)) return detail::read_zstd(file);
 #ifdef TEGA_HAVE_OPENIMAGEIO
   return detail::read_oiio(file);
 #else
@@ -52,6 +64,10 @@ StoredImage read_stored(const fs::path& file) {
 
 void write_stored(const StoredImage& image, const fs::path& file) {
   std::visit([&](const auto& buffer) { check_buffer(buffer, file); }, image);
+  if (is_zstd(file)) {
+    const PixelView view = view_of(image, file);
+    return write_file_atomic(file, [&](const fs::path& temp) { detail::write_zstd(view, temp, file, kZstdLevel); });
+  }
 #ifdef TEGA_HAVE_OPENIMAGEIO
   write_file_atomic(file, [&](const fs::path& temp) { detail::write_oiio(image, temp, file); });
 #else
@@ -116,6 +132,7 @@ void write_image(const Image8& image, const fs::path& file) { write_stored(image
 void write_image(const Image16& image, const fs::path& file) { write_stored(image, file); }
 
 bool image_format_supported(const fs::path& file) {
+  if (is_zstd(file)) return true;
 #ifdef TEGA_HAVE_OPENIMAGEIO
   return detail::oiio_can_write(file);
 #else
@@ -146,6 +163,15 @@ void write_png_view(const PixelView& view, const fs::path& file, int compression
     throw Error(file, "invalid pixel view or compression level for PNG");
   }
   write_file_atomic(file, [&](const fs::path& temp) { detail::write_png_rows(view, temp, file, compression); });
+}
+
+void write_zstd_view(const PixelView& view, const fs::path& file, int level) {
+  if (!view.data || view.width <= 0 || view.height <= 0 || view.channels < 1 || view.channels > 4 ||
+      (view.bit_depth != 8 && view.bit_depth != 16) ||
+      view.row_bytes < size_t(view.width) * view.channels * (view.bit_depth / 8) || level < 1 || level > 19) {
+    throw Error(file, "invalid pixel view or zstd level (1-19)");
+  }
+  write_file_atomic(file, [&](const fs::path& temp) { detail::write_zstd(view, temp, file, level); });
 }
 
 }  // namespace tega

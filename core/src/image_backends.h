@@ -8,6 +8,7 @@
 #include <variant>
 
 #include "tega/core/image.h"
+#include "tega/core/image_header.h"
 
 namespace tega::detail {
 
@@ -18,6 +19,12 @@ StoredImage read_png(const std::filesystem::path& file);
 void write_png(const StoredImage& image, const std::filesystem::path& target, const std::filesystem::path& file);
 void write_png_rows(const PixelView& view, const std::filesystem::path& target, const std::filesystem::path& file,
                     int compression);
+
+// Raw pixels in zstd (image_zstd.cpp), any build.
+StoredImage read_zstd(const std::filesystem::path& file);  // Image8 or Image16
+ImageHeader read_zstd_header(const std::filesystem::path& file);
+void write_zstd(const PixelView& view, const std::filesystem::path& target, const std::filesystem::path& file,
+                int level);
 
 #ifdef TEGA_HAVE_OPENIMAGEIO
 StoredImage read_oiio(const std::filesystem::path& file);

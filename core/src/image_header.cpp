@@ -5,11 +5,13 @@
 #include <cstring>
 #include <fstream>
 
+#include "image_backends.h"
 #include "tega/core/error.h"
 
 namespace tega {
 
 ImageHeader read_image_header(const std::filesystem::path& file) {
+  if (file.extension() == ".zst") return detail::read_zstd_header(file);
   // A PNG starts with an 8-byte signature and then the IHDR chunk:
   // length(4) "IHDR"(4) width(4) height(4) bit depth(1) colour type(1) ...
   std::ifstream in(file, std::ios::binary);

@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "clean_plate.h"
+#include "opencv_threads.h"
 #include "recorded_image.h"
 #include "tega/core/dataset.h"
 #include "tega/core/error.h"
@@ -34,6 +35,8 @@ void check_options(const DatasetBuildOptions& o) {
   if (o.frames < 0) fail("frames must be 0 (all) or positive");
   if (o.test_camera_count < 1) fail("test_camera_count must be 1 or more");
   if (o.png_compression < 0 || o.png_compression > 9) fail("png_compression must be in 0 .. 9");
+  if (o.image_format != "png" && o.image_format != "zst")
+    fail("image_format must be png or zst, not '" + o.image_format + "'");
 }
 
 bool contains(const std::vector<std::string>& names, const std::string& name) {
@@ -206,6 +209,7 @@ DatasetBuildSummary build_dataset(const DatasetBuildRequest& request, const Data
   check_views(frames, in, request.mattes, pool);
 
   Dataset dataset;
+  dataset.image_extension = "." + options.image_format;
   dataset.template_mesh = in.subject.neutral;
   dataset.eyeball_faces = eyeball_faces(in.subject.neutral, in.subject.eyeball_vertices);
   dataset.landmark_vertices.assign(in.subject.landmark_vertices.begin(), in.subject.landmark_vertices.end());
@@ -232,6 +236,7 @@ DatasetBuildSummary build_dataset(const DatasetBuildRequest& request, const Data
 
   const int64_t total = static_cast<int64_t>(frames.size() * in.rig.cameras.size());
   Progress progress("dataset build", total, "images");
+  const OpenCvSingleThreaded one_opencv_thread;
   int kept = 0;
   for (size_t c = 0; c < in.rig.cameras.size(); ++c) {
     const Camera& captured = in.rig.cameras[c];
@@ -263,8 +268,9 @@ DatasetBuildSummary build_dataset(const DatasetBuildRequest& request, const Data
                   : read_matte(matte_path(request.mattes, f, camera), captured.width, captured.height,
                                view_name(f, camera));
       const Image8 rgba = resampler.rgba(rgb, matte);
-      write_png_view({rgba.pixels.data(), rgba.width, rgba.height, 4, 8, static_cast<size_t>(rgba.width) * 4},
-                     dataset.image_path(camera, f.id()), options.png_compression);
+      const PixelView view{rgba.pixels.data(), rgba.width, rgba.height, 4, 8, static_cast<size_t>(rgba.width) * 4};
+      if (options.image_format == "zst") write_zstd_view(view, dataset.image_path(camera, f.id()), 1);
+      else write_png_view(view, dataset.image_path(camera, f.id()), options.png_compression);
       progress.advance();
     });
   }

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "clean_plate.h"
+#include "opencv_threads.h"
 #include "recorded_image.h"
 #include "tega/core/error.h"
 #include "tega/core/files.h"
@@ -69,6 +70,7 @@ MatteSummary matte_capture(const MatteRequest& request, const MatteOptions& opti
 
   ThreadPool pool(options.threads);
   Progress progress("matte", images, "images");
+  const OpenCvSingleThreaded one_opencv_thread;
   for (const TakeJob& job : jobs) {
     ++summary.takes;
     const fs::path options_file = job.out / "options.yaml";

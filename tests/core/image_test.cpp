@@ -4,7 +4,9 @@
 #include <functional>
 
 #include "tega/core/error.h"
+#include "tega/core/files.h"
 #include "tega/core/image.h"
+#include "tega/core/image_header.h"
 #include "test_support.h"
 
 namespace tega {
@@ -118,6 +120,48 @@ TEST(ImagePng, PixelViewWithRowPaddingIsWrittenExactlyAtEveryLevel) {
   }
   EXPECT_THROW(write_png_view({padded.data(), width, height, 1, 16, 4}, dir / "short_rows.png", 1), Error);
   EXPECT_FALSE(std::filesystem::exists(dir / "short_rows.png"));
+}
+
+TEST(ImageZstd, RoundTripsEightAndSixteenBitsWithItsHeader) {
+  test::TempDir dir;
+  for (int channels = 1; channels <= 4; ++channels) {
+    SCOPED_TRACE(channels);
+    const Image8 image = pattern<uint8_t>(13, 5, channels, 255);
+    write_image(image, dir / "eight.zst");
+    expect_same_image(read_image_u8(dir / "eight.zst"), image);
+    const ImageHeader header = read_image_header(dir / "eight.zst");
+    EXPECT_EQ(header.width, 13);
+    EXPECT_EQ(header.height, 5);
+    EXPECT_EQ(header.channels, channels);
+    EXPECT_EQ(header.bit_depth, 8);
+    const Image16 deep = pattern<uint16_t>(11, 7, channels, 65535);
+    write_image(deep, dir / "deep.zst");
+    expect_same_image(from_float<uint16_t>(read_image(dir / "deep.zst"), 65535), deep);
+    EXPECT_EQ(read_image_header(dir / "deep.zst").bit_depth, 16);
+  }
+  // A view with padded rows, as the dataset build writes it.
+  const Image8 rgba = pattern<uint8_t>(6, 4, 4, 255);
+  std::vector<uint8_t> padded(32 * 4, 0xAB);
+  for (int y = 0; y < 4; ++y) std::copy_n(&rgba.pixels[size_t(y) * 24], 24, &padded[size_t(y) * 32]);
+  write_zstd_view({padded.data(), 6, 4, 4, 8, 32}, dir / "view.zst", 3);
+  expect_same_image(read_image_u8(dir / "view.zst"), rgba);
+}
+
+TEST(ImageZstd, DamagedFilesAreErrorsNamingThem) {
+  test::TempDir dir;
+  write_image(pattern<uint8_t>(64, 64, 4, 255), dir / "good.zst");
+  std::string bytes = read_text_file(dir / "good.zst");
+  test::write_text(dir / "truncated.zst", bytes.substr(0, bytes.size() / 2));
+  test::write_text(dir / "not_tega.zst", "PNG or anything else, but not TEGAPIX1 pixels");
+  std::string wrong_size = bytes;
+  wrong_size[8] = 65;  // the header's width no longer matches the frame
+  test::write_text(dir / "wrong_size.zst", wrong_size);
+  for (const char* name : {"truncated.zst", "not_tega.zst", "wrong_size.zst"}) {
+    const auto file = dir / name;
+    const std::string message = error_message([&] { read_image_u8(file); });
+    EXPECT_EQ(message.rfind(file.string() + ": ", 0), 0u) << message;
+  }
+  EXPECT_NE(error_message([&] { read_image_header(dir / "not_tega.zst"); }).find("TEGAPIX1"), std::string::npos);
 }
 
 TEST(ImageErrors, NonImageAndMissingFilesAreNamed) {

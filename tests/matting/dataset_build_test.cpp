@@ -200,6 +200,28 @@ TEST_F(DatasetBuild, MattesMadeHereAreTegaMattesAndMatchTheTruth) {
   EXPECT_LT(worst_alpha, 0.02);  // the bound on a matte
 }
 
+TEST_F(DatasetBuild, ZstdImagesHoldThePngsPixels) {
+  DatasetBuildOptions options;
+  options.frames = 2;
+  options.test_takes = {"speech"};
+  const auto png = build(options, "png");
+  options.image_format = "zst";
+  const auto zst = build(options, "zst");
+  const Dataset a = read_dataset(png.dataset), b = read_dataset(zst.dataset);
+  validate_dataset(b);
+  EXPECT_EQ(b.image_extension, ".zst");
+  for (const auto& frame : b.frames) {
+    for (const auto& camera : b.rig.cameras) {
+      ASSERT_EQ(b.image_path(camera.name, frame.id).extension(), ".zst");
+      EXPECT_EQ(read_image_u8(b.image_path(camera.name, frame.id)).pixels,
+                read_image_u8(a.image_path(camera.name, frame.id)).pixels)
+          << camera.name << " " << frame.id;
+    }
+  }
+  options.image_format = "jpeg";
+  EXPECT_NE(error_of([&] { build(options, "jpeg"); }).find("image_format must be png or zst"), std::string::npos);
+}
+
 TEST_F(DatasetBuild, SamplesFramesUniformlyAndSplitsAsConfigured) {
   DatasetBuildOptions options;
   options.frames = 4;  // of the 6 tracked frames: the middles of 4 equal parts

@@ -40,6 +40,7 @@ struct Dataset {
   std::vector<int32_t> landmark_vertices;  // optional (e.g. 68 Multi-PIE landmarks)
   std::vector<DatasetFrame> frames;
   DatasetSplit train, test;  // test: held-out frames and held-out cameras
+  std::string image_extension = ".png";  // or ".zst": raw pixels in zstd (image.h)
 
   std::filesystem::path mesh_path(const std::string& frame_id) const;
   std::filesystem::path image_path(const std::string& camera, const std::string& frame_id) const;

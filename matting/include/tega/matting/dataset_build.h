@@ -20,6 +20,7 @@ struct DatasetBuildOptions {
   std::vector<std::string> test_takes;
   std::vector<std::string> test_cameras;
   int test_camera_count = 2;
+  std::string image_format = "png";  // png | zst
   int png_compression = 1;
   int threads = 0;
   MatteOptions matte;  // without a MATTES folder; its `threads` is not used
@@ -40,6 +41,9 @@ struct DatasetBuildOptions {
       "over the rig.");
     v("test_camera_count", test_camera_count,
       "Held-out cameras when test_cameras is empty (clamped to 1 .. cameras - 1).");
+    v("image_format", image_format,
+      "png (any image viewer opens it) or zst (tega's raw pixels in zstd: about the same size, written 2-3 times "
+      "and read 3-4 times faster; docs/layouts.md#raw-pixels-in-zstd).");
     v("png_compression", png_compression,
       "zlib level of the images (0-9): 1 writes several times faster than 6 for files about 10% larger "
       "(docs/matting.md#storage).");
