@@ -38,6 +38,9 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kCheckpoint = "checkpoint.safetensors";
+// The checkpoint before the latest: what a resume falls back on when the
+// latest cannot be read (a disk error, a copy cut short).
+constexpr const char* kPreviousCheckpoint = "checkpoint.previous.safetensors";
 constexpr const char* kOptions = "options.yaml";
 constexpr const char* kMetrics = "metrics.csv";
 
@@ -112,7 +115,7 @@ class Run {
     background_ = at::tensor(options_.background, at::kFloat).to(device_);
 
     if (resume) {
-      restore(read_checkpoint(run_dir_ / kCheckpoint));
+      restore_latest();
     } else {
       model_.gaussians = initialise_gaussians(model_.lookup(), options_.initial_gaussians, model_.metres_per_uv(),
                                               options_.binding == "triangle", static_cast<uint64_t>(options_.seed),
@@ -367,19 +370,40 @@ class Run {
     c.tensors["trainer.iteration"] = at::tensor({iteration_}, at::kLong);
     c.tensors["trainer.rng_state"] = generator_.get_state();
     c.metadata["options"] = options_to_yaml(options_);
+    // Kept until this one is written whole: killed in between, the run
+    // resumes from it.
+    if (fs::exists(run_dir_ / kCheckpoint)) fs::rename(run_dir_ / kCheckpoint, run_dir_ / kPreviousCheckpoint);
     write_checkpoint(run_dir_ / kCheckpoint, c);
     write_metrics(run_dir_ / kMetrics, metrics_);
     saved_iteration_ = iteration_;
   }
 
-  void restore(const Checkpoint& c) {
+  // The latest checkpoint or, where it is missing or cannot be read, the one
+  // before it, with a warning.
+  void restore_latest() {
+    const fs::path latest = run_dir_ / kCheckpoint, previous = run_dir_ / kPreviousCheckpoint;
+    std::string why = latest.string() + ": is missing";
+    if (fs::exists(latest)) {
+      try {
+        return restore(read_checkpoint(latest), latest);
+      } catch (const Error& e) {
+        if (!fs::exists(previous)) throw;
+        why = e.what();
+      }
+    }
+    if (!fs::exists(previous)) throw Error(run_dir_, "has no checkpoint to resume from");
+    logging::warn("%s; resuming from the checkpoint before it, %s", why.c_str(), previous.c_str());
+    restore(read_checkpoint(previous), previous);
+  }
+
+  void restore(const Checkpoint& c, const fs::path& file) {
     model_.gaussians = gaussians_from_tensors(c.tensors, device_);
-    nn::load_module_tensors(*model_.network, c.tensors, run_dir_ / kCheckpoint, "network.");
+    nn::load_module_tensors(*model_.network, c.tensors, file, "network.");
     register_parameters();
     adam_.load_state(c.tensors);
     const auto tensor = [&](const char* name) {
       auto it = c.tensors.find(name);
-      if (it == c.tensors.end()) throw Error(run_dir_ / kCheckpoint, std::string("has no tensor '") + name + "'");
+      if (it == c.tensors.end()) throw Error(file, std::string("has no tensor '") + name + "'");
       return it->second.to(device_);
     };
     stats_.grad_norm_sum = tensor("densify.gradient_norm_sum");
@@ -388,7 +412,7 @@ class Run {
     generator_.set_state(tensor("trainer.rng_state").cpu());
     iteration_ = saved_iteration_ = c.iteration();
     metrics_ = read_metrics(run_dir_ / kMetrics, iteration_);
-    logging::info("resumed %s at iteration %lld", (run_dir_ / kCheckpoint).c_str(), static_cast<long long>(iteration_));
+    logging::info("resumed %s at iteration %lld", file.c_str(), static_cast<long long>(iteration_));
   }
 
   double heldout_psnr() {
@@ -435,10 +459,13 @@ class Run {
 TrainSummary train(const fs::path& dataset, const fs::path& run, TrainOptions options, const RunControl& control) {
   at::set_num_threads(options.cpu_threads > 0 ? options.cpu_threads
                                               : static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+  const bool has_checkpoint = fs::exists(run / kCheckpoint) || fs::exists(run / kPreviousCheckpoint);
   if (control.resume) {
-    if (!fs::exists(run / kCheckpoint)) throw Error(run, "has no checkpoint to resume from");
-  } else if (fs::exists(run / kCheckpoint) && !control.overwrite) {
+    if (!has_checkpoint) throw Error(run, "has no checkpoint to resume from");
+  } else if (has_checkpoint && !control.overwrite) {
     throw Error(run, "already holds a run (pass --resume to continue it, or --force to start over)");
+  } else {
+    fs::remove(run / kPreviousCheckpoint);  // the run it belonged to is over
   }
   fs::create_directories(run);
   write_text_atomic(run / kOptions, options_to_yaml(options));

@@ -3,6 +3,8 @@
 namespace tega::pipeline {
 namespace {
 
+namespace fs = std::filesystem;
+
 std::vector<std::string> with_config(std::vector<std::string> arguments, const ShardPaths& p) {
   arguments.insert(arguments.end(), {"--config", p.options_file.string()});
   return arguments;
@@ -56,8 +58,14 @@ std::vector<StageKind> make_stage_kinds() {
   train.provides = {{"run", "run"}};
   train.path_options = {"loss.vgg_weights"};
   train.device_option = "device";
+  // A shard killed mid-run continues from its last checkpoint.
+  train.resumes_in_staging = true;
   train.arguments = [](const ShardPaths& p) {
-    return with_config({"--data", p.artifacts.at("dataset").string(), "--out", (p.output / "run").string()}, p);
+    const fs::path run = p.output / "run";
+    std::vector<std::string> arguments{"--data", p.artifacts.at("dataset").string(), "--out", run.string()};
+    if (fs::exists(run / "checkpoint.safetensors") || fs::exists(run / "checkpoint.previous.safetensors"))
+      arguments.push_back("--resume");
+    return with_config(arguments, p);
   };
   kinds.push_back(train);
 

@@ -39,6 +39,22 @@ TrainOptions tiny_options() {
   return o;
 }
 
+// The Gaussians and network weights of two runs' final checkpoints agree.
+void expect_same_parameters(const std::filesystem::path& a_run, const std::filesystem::path& b_run) {
+  const Checkpoint a = read_checkpoint(a_run / "checkpoint.safetensors");
+  const Checkpoint b = read_checkpoint(b_run / "checkpoint.safetensors");
+  int compared = 0;
+  for (const auto& [name, tensor] : a.tensors) {
+    if (name.rfind("gaussians.", 0) != 0 && name.rfind("network.", 0) != 0) continue;
+    ASSERT_TRUE(b.tensors.count(name)) << name;
+    ASSERT_EQ(tensor.sizes(), b.tensors.at(name).sizes()) << name;
+    EXPECT_TRUE(at::allclose(tensor, b.tensors.at(name), 1e-5, 1e-7))
+        << name << ": max difference " << (tensor - b.tensors.at(name)).abs().max().item<double>();
+    ++compared;
+  }
+  EXPECT_GE(compared, 10);
+}
+
 TEST(Trainer, ResumeReproducesAnUninterruptedRun) {
   tega::test::TempDir tmp;
   tega::test::write_tiny_dataset(tmp / "data");
@@ -52,19 +68,7 @@ TEST(Trainer, ResumeReproducesAnUninterruptedRun) {
   const TrainSummary rest = train(tmp / "data", tmp / "sliced", options, {.resume = true});
   EXPECT_EQ(rest.iterations, 6);
   EXPECT_EQ(rest.gaussians, straight.gaussians);
-
-  const Checkpoint a = read_checkpoint(tmp / "straight/checkpoint.safetensors");
-  const Checkpoint b = read_checkpoint(tmp / "sliced/checkpoint.safetensors");
-  int compared = 0;
-  for (const auto& [name, tensor] : a.tensors) {
-    if (name.rfind("gaussians.", 0) != 0 && name.rfind("network.", 0) != 0) continue;
-    ASSERT_TRUE(b.tensors.count(name)) << name;
-    ASSERT_EQ(tensor.sizes(), b.tensors.at(name).sizes()) << name;
-    EXPECT_TRUE(at::allclose(tensor, b.tensors.at(name), 1e-5, 1e-7))
-        << name << ": max difference " << (tensor - b.tensors.at(name)).abs().max().item<double>();
-    ++compared;
-  }
-  EXPECT_GE(compared, 10);
+  expect_same_parameters(tmp / "straight", tmp / "sliced");
   // The whole loss curve, before and after the interruption.
   const auto losses = [](const std::filesystem::path& file) {
     std::vector<double> values;
@@ -79,6 +83,34 @@ TEST(Trainer, ResumeReproducesAnUninterruptedRun) {
   ASSERT_EQ(straight_losses.size(), 6u);
   ASSERT_EQ(sliced_losses.size(), 6u);
   for (size_t i = 0; i < 6; ++i) EXPECT_NEAR(straight_losses[i], sliced_losses[i], 1e-5 * straight_losses[i]) << i;
+}
+
+// A latest checkpoint cut short (a copy interrupted, a disk error): the
+// resume falls back on the one before it and still ends where an
+// uninterrupted run does.
+TEST(Trainer, ADamagedLatestCheckpointResumesFromTheOneBefore) {
+  tega::test::TempDir tmp;
+  tega::test::write_tiny_dataset(tmp / "data");
+  TrainOptions options = tiny_options();
+  options.checkpoint_every = 2;
+  train(tmp / "data", tmp / "straight", options, {});
+  train(tmp / "data", tmp / "sliced", options, {.stop_at = 5});  // checkpoints 2, 4 and 5
+  const auto latest = tmp / "sliced/checkpoint.safetensors";
+  ASSERT_EQ(read_checkpoint(tmp / "sliced/checkpoint.previous.safetensors").iteration(), 4);
+  std::filesystem::resize_file(latest, std::filesystem::file_size(latest) / 2);
+  const TrainSummary rest = train(tmp / "data", tmp / "sliced", options, {.resume = true});
+  EXPECT_EQ(rest.iterations, 6);
+  expect_same_parameters(tmp / "straight", tmp / "sliced");
+
+  // With neither readable, the error names the latest.
+  std::filesystem::resize_file(latest, 100);
+  std::filesystem::remove(tmp / "sliced/checkpoint.previous.safetensors");
+  try {
+    train(tmp / "data", tmp / "sliced", options, {.resume = true});
+    FAIL() << "expected an error";
+  } catch (const tega::Error& e) {
+    EXPECT_NE(std::string(e.what()).find(latest.string()), std::string::npos) << e.what();
+  }
 }
 
 TEST(Trainer, ExistingRunIsNotOverwrittenByAccident) {

@@ -4,6 +4,7 @@
 // A run directory holds (docs/layouts.md#run):
 //   RUN/options.yaml                 the options of the run
 //   RUN/checkpoint.safetensors       the latest checkpoint (atomic)
+//   RUN/checkpoint.previous.safetensors  the one before it, which a resume falls back on
 //   RUN/metrics.csv                  iteration, loss, psnr, gaussians, seconds
 //   RUN/run.json                     dataset, state and the final summary
 
@@ -32,6 +33,7 @@ struct TrainSummary {
 struct RunControl {
   // Continue from RUN/checkpoint.safetensors: parameters, optimizer, RNG and
   // densification state, so the run goes on exactly as if uninterrupted.
+  // Where it is missing or damaged, from the checkpoint before it (warned).
   bool resume = false;
   // Without resume, an existing run is an error unless this is set.
   bool overwrite = false;

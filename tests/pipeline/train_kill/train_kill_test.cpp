@@ -1,0 +1,139 @@
+// Kill -9 `tega run` while its train shard trains, then run it again: the
+// shard resumes from its last checkpoint (never from iteration 0) and ends
+// with the parameters of an uninterrupted run.
+
+#include <ATen/ATen.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <random>
+#include <regex>
+#include <thread>
+
+#include "pipeline_test_support.h"
+#include "tega/core/error.h"
+#include "tega/core/files.h"
+#include "tega/trainer/checkpoint.h"
+#include "test_support.h"
+
+namespace tega::test {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+constexpr int kTrials = 10;
+constexpr int kIterations = 200;
+
+// The virtual studio's tiniest capture and a training run of a few seconds
+// on one CPU thread (deterministic), checkpointing every 10 iterations.
+std::string config_text() {
+  return "workspace: unused\nstages:\n  synth:\n    options:\n" + tiny_synth_options(6) +
+         "  train:\n    after: [synth]\n    options:\n"
+         "      device: cpu\n      cpu_threads: 1\n      loader_threads: 1\n      prefetch: 2\n"
+         "      iterations: " + std::to_string(kIterations) + "\n      checkpoint_every: 10\n      log_every: 1\n"
+         "      initial_gaussians: 64\n      warmup: 0.25\n"
+         "      densify: {start: 0.0, stop: 1.0, interval: 0.25, gradient_threshold: 0.0}\n"
+         "      loss: {smoothness_samples: 32}\n"
+         "      network: {texture_size: 16, unet_widths: [4, 8], latent_channels: 4, mlp_hidden: 8}\n"
+         "      uv_lookup: {resolution: 32}\n";
+}
+
+std::vector<std::string> run_args(const fs::path& config, const fs::path& workspace) {
+  return {"run", config.string(), "--workspace", workspace.string()};
+}
+
+fs::path committed_run(const fs::path& workspace) { return workspace / "train" / "default" / "run"; }
+
+// The iteration of the checkpoint a killed shard left in its staging
+// directory, or 0 where it left none that can be read.
+int64_t staged_iteration(const fs::path& workspace) {
+  if (!fs::exists(workspace / "train")) return 0;
+  for (const auto& entry : fs::directory_iterator(workspace / "train")) {
+    const fs::path checkpoint = entry.path() / "run" / "checkpoint.safetensors";
+    if (entry.path().filename().string().find("staging") == std::string::npos || !fs::exists(checkpoint)) continue;
+    try {
+      return trainer::read_checkpoint(checkpoint).iteration();
+    } catch (const Error&) {
+      return 0;
+    }
+  }
+  return 0;
+}
+
+void expect_same_parameters(const fs::path& a_run, const fs::path& b_run) {
+  const auto a = trainer::read_checkpoint(a_run / "checkpoint.safetensors");
+  const auto b = trainer::read_checkpoint(b_run / "checkpoint.safetensors");
+  EXPECT_EQ(a.iteration(), b.iteration());
+  int compared = 0;
+  for (const auto& [name, tensor] : a.tensors) {
+    if (name.rfind("gaussians.", 0) != 0 && name.rfind("network.", 0) != 0) continue;
+    ASSERT_TRUE(b.tensors.count(name)) << name;
+    ASSERT_EQ(tensor.sizes(), b.tensors.at(name).sizes()) << name;
+    EXPECT_TRUE(at::allclose(tensor, b.tensors.at(name), 1e-5, 1e-7)) << name;
+    ++compared;
+  }
+  EXPECT_GE(compared, 10);
+}
+
+TEST(KillNineTraining, AKilledTrainShardResumesFromItsCheckpoint) {
+  if (!tega_has_command({"synth"}) || !tega_has_command({"train"})) GTEST_SKIP() << "this build has no synth or train";
+  TempDir dir;
+  write_text(dir / "p.yaml", config_text());
+  const fs::path config = dir / "p.yaml";
+
+  // The reference: synth alone, then train timed alone.
+  ASSERT_EQ(run_tega({"run", config.string(), "--workspace", (dir / "reference").string(), "--only", "synth"},
+                     dir.path()).exit_code, 0);
+  const auto start = Clock::now();
+  const auto reference = run_tega(run_args(config, dir / "reference"), dir.path());
+  const double train_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  ASSERT_EQ(reference.exit_code, 0) << reference.output;
+
+  std::mt19937 random(20261125);
+  std::uniform_real_distribution<double> moment(0.0, 1.0);
+  int resumed_from_a_checkpoint = 0;
+  for (int trial = 0; trial < kTrials; ++trial) {
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    const fs::path ws = dir / ("trial" + std::to_string(trial));
+    ASSERT_EQ(run_tega({"run", config.string(), "--workspace", ws.string(), "--only", "synth"}, dir.path()).exit_code,
+              0);
+    int64_t killed_at = 0;
+    for (int kill = 0; kill < (trial % 3 == 2 ? 2 : 1); ++kill) {
+      const pid_t run = spawn_tega(run_args(config, ws), dir / "killed-output.txt");
+      ASSERT_GT(run, 0);
+      // Every fourth kill at any moment of the run; the others once the
+      // shard has a checkpoint, at any moment of its training after that.
+      if (trial % 4 != 0) {
+        const auto started = Clock::now();
+        while (staged_iteration(ws) == 0 && Clock::now() - started < std::chrono::duration<double>(2 * train_seconds))
+          std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      }
+      std::this_thread::sleep_for(std::chrono::duration<double>(moment(random) * train_seconds * 0.6));
+      ::kill(run, SIGKILL);
+      wait_for_exit(run);
+      EXPECT_TRUE(wait_until_no_process_mentions(ws.string(), std::chrono::seconds(5)))
+          << "a shard process outlived its orchestrator";
+      if (fs::exists(committed_run(ws))) break;  // it had finished
+      killed_at = staged_iteration(ws);
+    }
+    const auto resumed = run_tega(run_args(config, ws), dir.path());
+    ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+    if (killed_at > 0) {
+      // The trainer's own words, in the shard's log.
+      const std::string log = read_text_file(ws / "logs" / "train" / "default.log");
+      EXPECT_TRUE(std::regex_search(log, std::regex("resumed .*checkpoint.*at iteration " + std::to_string(killed_at))))
+          << "killed with a checkpoint at iteration " << killed_at << "; log:\n" << log;
+      ++resumed_from_a_checkpoint;
+    }
+    expect_same_parameters(committed_run(dir / "reference"), committed_run(ws));
+    EXPECT_TRUE(staging_dirs(ws).empty());
+  }
+  // Most kills land after a checkpoint: those resumes are what this tests.
+  EXPECT_GE(resumed_from_a_checkpoint, kTrials / 2);
+  std::printf("%d of %d trials resumed from a checkpoint; the others had none yet or had finished\n",
+              resumed_from_a_checkpoint, kTrials);
+}
+
+}  // namespace
+}  // namespace tega::test
