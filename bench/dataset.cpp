@@ -14,7 +14,6 @@
 #include <filesystem>
 #include <optional>
 
-#include "tega/core/downsample.h"
 #include "tega/core/files.h"
 #include "tega/core/image.h"
 #include "tega/core/mesh.h"
