@@ -43,15 +43,7 @@ void write_synthetic_model(const std::filesystem::path& dir) {
   test::write_text(dir / "model.mtl", "newmtl skin\n");
 }
 
-std::string error_message(const std::function<void()>& action) {
-  try {
-    action();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no tega::Error thrown";
-  return "";
-}
+using test::error_message;
 
 void expect_near(const Vertices& actual, const Vertices& expected, float tolerance) {
   ASSERT_EQ(actual.rows(), expected.rows());

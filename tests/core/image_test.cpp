@@ -47,15 +47,7 @@ void expect_same_image(const ImageBuffer<T>& actual, const ImageBuffer<T>& expec
   EXPECT_TRUE(actual.pixels == expected.pixels);
 }
 
-std::string error_message(const std::function<void()>& action) {
-  try {
-    action();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no tega::Error thrown";
-  return "";
-}
+using test::error_message;
 
 TEST(ImagePng, EightBitRoundTripsEveryChannelCount) {
   test::TempDir dir;

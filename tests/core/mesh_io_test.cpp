@@ -54,15 +54,7 @@ std::vector<float> corner_uvs(const Mesh& mesh) {
   return uvs;
 }
 
-std::string error_message(const std::function<void()>& action) {
-  try {
-    action();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no tega::Error thrown";
-  return "";
-}
+using test::error_message;
 
 TEST(MeshObj, RoundTripKeepsSeamsPolygonsAndExactFloats) {
   test::TempDir dir;

@@ -25,7 +25,7 @@ namespace fs = std::filesystem;
 namespace tega::matting {
 namespace {
 
-constexpr int kFrames = 3;  // per take
+constexpr int kFramesPerTake = 3;
 
 // The studio's true alpha as `tega matte` would write it.
 void write_true_mattes(const fs::path& capture, const fs::path& mattes) {
@@ -44,7 +44,7 @@ class DatasetBuild : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new test::TempDir;
-    synth::Options studio = test::small_studio(13, 512, 384, kFrames);
+    synth::Options studio = test::small_studio(13, 512, 384, kFramesPerTake);
     studio.takes = {"expressions", "speech"};
     studio.test_takes = {"speech"};
     studio.test_cameras = 2;
@@ -165,7 +165,7 @@ TEST_F(DatasetBuild, MatchesTheStudiosOwnDatasetAtFullAndHalfSize) {
     options.frames = 0;
     options.test_takes = {"speech"};
     const auto s = build(options, "x" + std::to_string(downsample));
-    EXPECT_EQ(s.images, 2 * kFrames * 13);
+    EXPECT_EQ(s.images, 2 * kFramesPerTake * 13);
     EXPECT_EQ(s.images_kept, 0);
     expect_matches_truth(s.dataset, capture() / "dataset", downsample);
   }
@@ -247,7 +247,7 @@ TEST_F(DatasetBuild, SamplesFramesUniformlyAndSplitsAsConfigured) {
   options.test_camera_count = 3;
   const Dataset other = read_dataset(build(options, "counted").dataset);
   EXPECT_EQ(other.test.cameras, spread_test_cameras(other.rig, 3));
-  EXPECT_EQ(other.test.frames.size(), size_t(kFrames));
+  EXPECT_EQ(other.test.frames.size(), size_t(kFramesPerTake));
   EXPECT_EQ(other.frame(other.test.frames.front()).sequence, "expressions");
 }
 
@@ -265,7 +265,7 @@ TEST_F(DatasetBuild, AnInterruptedBuildContinuesWhereItStopped) {
 
   fs::copy_file(mattes() / "speech" / "cam12" / "000002.png", matte, fs::copy_options::overwrite_existing);
   const auto resumed = build(options, "resumed", {}, damaged);
-  EXPECT_GE(resumed.images_kept, 12 * 2 * kFrames);
+  EXPECT_GE(resumed.images_kept, 12 * 2 * kFramesPerTake);
   EXPECT_LT(resumed.images_kept, resumed.images);
   EXPECT_FALSE(fs::exists(out_ / "resumed.partial"));
   EXPECT_FALSE(fs::exists(resumed.dataset / ".resume-key"));

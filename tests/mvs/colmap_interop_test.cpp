@@ -15,7 +15,7 @@ namespace tega::mvs {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kRadius = 0.1;
+using test::kRadius;
 // COLMAP's MVS takes depth-map pixel (col, row) on the ray through image
 // coordinate (col, row) in its own convention, which puts pixel centres at +0.5:
 // half a pixel up and left of the centre (colmap_workspace.h).

@@ -13,17 +13,9 @@ namespace tega::mvs {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kRadius = 0.1;
+using test::kRadius;
 
-std::string error_of(const std::function<void()>& action) {
-  try {
-    action();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no tega::Error thrown";
-  return "";
-}
+using tega::test::error_message;
 
 #define EXPECT_CONTAINS(text, part) \
   EXPECT_NE(std::string(text).find(part), std::string::npos) << "'" << (text) << "' lacks '" << (part) << "'"
@@ -70,7 +62,7 @@ TEST(ColmapArray, WritesColmapsHeaderThenChannelAfterChannel) {
   EXPECT_EQ(width, 2);
   EXPECT_EQ(height, 1);
   EXPECT_EQ(channels, 2);
-  EXPECT_CONTAINS(error_of([&] {
+  EXPECT_CONTAINS(error_message([&] {
                     write_colmap_array(dir / "b.bin", 2, 2, 1, {1, 2, 3});
                   }),
                   (dir / "b.bin").string() + ": size mismatch");
@@ -82,7 +74,7 @@ TEST(ColmapArray, BadFilesNameTheFileAndTheProblem) {
   int width, height, channels;
   const auto read = [&](const std::string& bytes) {
     write_bytes(dir / "x.bin", bytes);
-    return error_of([&] { read_colmap_array(dir / "x.bin", width, height, channels); });
+    return error_message([&] { read_colmap_array(dir / "x.bin", width, height, channels); });
   };
   const std::string file = (dir / "x.bin").string() + ": ";
   EXPECT_CONTAINS(read("2&x&1&"), file + "bad header");
@@ -91,7 +83,7 @@ TEST(ColmapArray, BadFilesNameTheFileAndTheProblem) {
   EXPECT_CONTAINS(read("2&2&1&" + bytes_of(std::vector<float>{1, 2, 3})), file + "truncated data");
   EXPECT_CONTAINS(read("999999&999999&99&" + bytes_of(std::vector<float>{1})), file + "truncated data");
   EXPECT_CONTAINS(read("1&1&1&" + bytes_of(std::vector<float>{1, 2})), file + "size mismatch");
-  EXPECT_CONTAINS(error_of([&] { read_colmap_array(dir / "missing.bin", width, height, channels); }),
+  EXPECT_CONTAINS(error_message([&] { read_colmap_array(dir / "missing.bin", width, height, channels); }),
                   (dir / "missing.bin").string());
 }
 
@@ -126,7 +118,7 @@ TEST(PointCloudPly, BadFilesNameTheFileAndTheProblem) {
   const std::string file = (dir / "x.ply").string() + ": ";
   const auto read = [&](const std::string& content) {
     write_bytes(dir / "x.ply", content);
-    return error_of([&] { read_point_cloud_ply(dir / "x.ply"); });
+    return error_message([&] { read_point_cloud_ply(dir / "x.ply"); });
   };
   EXPECT_CONTAINS(read(bytes.substr(0, bytes.size() - 5)), file + "truncated data");
   EXPECT_CONTAINS(read("not a ply"), file + "bad header");
@@ -229,29 +221,29 @@ TEST(DenseWorkspace, ReadsColmapsFilesWrittenByHand) {
   EXPECT_FALSE(workspace.fused);
 
   fs::remove(ws / "stereo/normal_maps/left.png.geometric.bin");
-  EXPECT_CONTAINS(error_of([&] { read_dense_workspace(ws); }),
+  EXPECT_CONTAINS(error_message([&] { read_dense_workspace(ws); }),
                   (ws / "stereo/normal_maps/left.png.geometric.bin").string() + ": missing");
   write_bytes(ws / "stereo/normal_maps/left.png.geometric.bin", "3&2&3&" + bytes_of(std::vector<float>(17)));
-  EXPECT_CONTAINS(error_of([&] { read_dense_workspace(ws); }),
+  EXPECT_CONTAINS(error_message([&] { read_dense_workspace(ws); }),
                   (ws / "stereo/normal_maps/left.png.geometric.bin").string() + ": truncated data");
   write_bytes(ws / "stereo/normal_maps/left.png.geometric.bin", "3&2&3&" + bytes_of(normals_planar));
   fs::remove(ws / "images/right.png");
-  EXPECT_CONTAINS(error_of([&] { read_dense_workspace(ws); }), "no image of camera 'right'");
+  EXPECT_CONTAINS(error_message([&] { read_dense_workspace(ws); }), "no image of camera 'right'");
 }
 
 TEST(DenseWorkspace, RefusesWhatItCannotWrite) {
   tega::test::TempDir dir;
   DenseWorkspace workspace = sphere_workspace();
   workspace.source_views["cam01"] = {"cam09"};
-  EXPECT_CONTAINS(error_of([&] { write_dense_workspace(workspace, dir / "ws"); }),
+  EXPECT_CONTAINS(error_message([&] { write_dense_workspace(workspace, dir / "ws"); }),
                   "source view 'cam09' of camera 'cam01' is not in the rig");
   workspace = sphere_workspace();
   workspace.rig.cameras[1].distortion[0] = 0.1;
-  EXPECT_CONTAINS(error_of([&] { write_dense_workspace(workspace, dir / "ws"); }), "camera 'cam01' has distortion");
+  EXPECT_CONTAINS(error_message([&] { write_dense_workspace(workspace, dir / "ws"); }), "camera 'cam01' has distortion");
   workspace = sphere_workspace();
   workspace.depth_maps["cam00"].normals.pop_back();
-  EXPECT_CONTAINS(error_of([&] { write_dense_workspace(workspace, dir / "ws"); }), "the depth map of camera 'cam00'");
-  EXPECT_CONTAINS(error_of([&] { write_dense_workspace(sphere_workspace(), dir / "ws", "raw"); }),
+  EXPECT_CONTAINS(error_message([&] { write_dense_workspace(workspace, dir / "ws"); }), "the depth map of camera 'cam00'");
+  EXPECT_CONTAINS(error_message([&] { write_dense_workspace(sphere_workspace(), dir / "ws", "raw"); }),
                   "depth map type 'raw'");
   EXPECT_FALSE(fs::exists(dir / "ws"));
 }

@@ -10,7 +10,7 @@
 namespace tega::mvs {
 namespace {
 
-constexpr double kRadius = 0.1;
+using test::kRadius;
 
 // Faces of `mesh` whose centroid has z > 0.
 std::vector<int> upper_faces(const Mesh& mesh) {

@@ -35,8 +35,8 @@ double completeness_at_3mm(const Mesh& mesh, const StudioTruth& truth, double& m
 }
 
 TEST(MvsPhotos, AColmapRiggedPhotoSetAndItsWorkspaceMeshTheFace) {
-  const test::TempDir dir;
-  synth::render_virtual_studio(test::small_studio(7, 320, 240, 1), dir / "capture");
+  const tega::test::TempDir dir;
+  synth::render_virtual_studio(tega::test::small_studio(7, 320, 240, 1), dir / "capture");
   const Rig rig = read_rig_json(dir / "capture" / "rig.json");
   write_colmap_text(rig, dir / "sparse");
   fs::create_directories(dir / "photos");

@@ -21,9 +21,9 @@ namespace tega::mvs {
 namespace {
 
 const fs::path& studio_capture() {
-  static const test::TempDir dir;
+  static const tega::test::TempDir dir;
   static const fs::path root = [] {
-    synth::render_virtual_studio(test::small_studio(13, 512, 384, 2), dir / "capture");
+    synth::render_virtual_studio(tega::test::small_studio(13, 512, 384, 2), dir / "capture");
     return dir / "capture";
   }();
   return root;
@@ -38,23 +38,16 @@ Options cpu_options() {
   return o;
 }
 
-std::string error_of(const std::function<void()>& run) {
-  try {
-    run();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using tega::test::error_message;
 
 // A copy of the capture with frame 1 only, to damage.
-fs::path copy_capture(const test::TempDir& dir) {
+fs::path copy_capture(const tega::test::TempDir& dir) {
   fs::copy(studio_capture(), dir / "capture", fs::copy_options::recursive);
   return dir / "capture";
 }
 
 TEST(Mvs, MeshesTheFaceWithinTheTargets) {
-  const test::TempDir out;
+  const tega::test::TempDir out;
   MvsRequest request;
   request.capture = studio_capture();
   request.out = out / "meshes";
@@ -84,25 +77,25 @@ TEST(Mvs, MeshesTheFaceWithinTheTargets) {
 }
 
 TEST(Mvs, ACameraMissingFromTheRigIsNamed) {
-  const test::TempDir dir;
+  const tega::test::TempDir dir;
   const fs::path capture = copy_capture(dir);
   Rig rig = read_rig_json(capture / "rig.json");
   rig.cameras.erase(rig.cameras.begin() + 4);
   write_rig_json(rig, dir / "partial-rig.json");
   MvsRequest request{capture, {}, dir / "meshes", dir / "partial-rig.json", 1, 2};
-  const std::string error = error_of([&] { reconstruct_capture(request, cpu_options()); });
+  const std::string error = error_message([&] { reconstruct_capture(request, cpu_options()); });
   EXPECT_NE(error.find("partial-rig.json"), std::string::npos) << error;
   EXPECT_NE(error.find("cam04"), std::string::npos) << error;
   EXPECT_FALSE(fs::exists(dir / "meshes" / "expressions" / "000001.ply"));
 }
 
 TEST(Mvs, AnUnreadableImageNamesTheFrameAndFileAndLeavesNoMesh) {
-  const test::TempDir dir;
+  const tega::test::TempDir dir;
   const fs::path capture = copy_capture(dir);
   const fs::path image = capture / "takes" / "expressions" / "cam07" / "000001.png";
   write_text_atomic(image, "not a png");
   MvsRequest request{capture, {}, dir / "meshes", {}, 1, 2};
-  const std::string error = error_of([&] { reconstruct_capture(request, cpu_options()); });
+  const std::string error = error_message([&] { reconstruct_capture(request, cpu_options()); });
   EXPECT_NE(error.find("frame 1"), std::string::npos) << error;
   EXPECT_NE(error.find(image.string()), std::string::npos) << error;
   EXPECT_FALSE(fs::exists(dir / "meshes" / "expressions" / "000001.ply"));
@@ -110,7 +103,7 @@ TEST(Mvs, AnUnreadableImageNamesTheFrameAndFileAndLeavesNoMesh) {
 }
 
 TEST(Mvs, AFrameTooFewCamerasSeeIsRefused) {
-  const test::TempDir dir;
+  const tega::test::TempDir dir;
   const fs::path capture = copy_capture(dir);
   // All but two cameras see the empty studio in frame 1.
   const auto cameras = read_rig_json(capture / "rig.json").camera_names();
@@ -118,7 +111,7 @@ TEST(Mvs, AFrameTooFewCamerasSeeIsRefused) {
     fs::copy_file(capture / "takes" / "clean_plate" / cameras[k] / "000000.png",
                   capture / "takes" / "expressions" / cameras[k] / "000001.png", fs::copy_options::overwrite_existing);
   MvsRequest request{capture, {}, dir / "meshes", {}, 1, 2};
-  const std::string error = error_of([&] { reconstruct_capture(request, cpu_options()); });
+  const std::string error = error_message([&] { reconstruct_capture(request, cpu_options()); });
   EXPECT_NE(error.find("frame 1: the subject is seen by 2 camera(s) (cam00, cam01)"), std::string::npos) << error;
   EXPECT_FALSE(fs::exists(dir / "meshes" / "expressions" / "000001.ply"));
 }

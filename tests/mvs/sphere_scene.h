@@ -18,6 +18,9 @@
 
 namespace tega::mvs::test {
 
+// The radius of the tests' sphere, metres.
+inline constexpr double kRadius = 0.1;
+
 // A camera at `center` looking at the origin (OpenCV axes).
 inline Camera camera_looking_at_origin(const std::string& name, const Eigen::Vector3d& center, int width, int height,
                                        double focal) {

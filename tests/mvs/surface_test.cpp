@@ -10,7 +10,7 @@
 namespace tega::mvs {
 namespace {
 
-constexpr double kRadius = 0.1;
+using test::kRadius;
 
 // Octree depth 8 resolves a 0.2 m sphere to ~1 mm cells, enough for these
 // checks in a fraction of depth 9's time. One thread: OpenMP's waiting

@@ -45,6 +45,16 @@ void write_text(const std::filesystem::path& file, const std::string& text) {
   out << text;
 }
 
+std::string error_message(const std::function<void()>& action) {
+  try {
+    action();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no tega::Error thrown";
+  return "";
+}
+
 void write_tiny_dataset(const std::filesystem::path& root) {
   Dataset d;
   d.root = root;

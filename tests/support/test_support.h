@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -28,6 +29,10 @@ class TempDir {
 };
 
 void write_text(const std::filesystem::path& file, const std::string& text);
+
+// The message of the tega::Error that `action` throws; a test failure when it
+// throws none.
+std::string error_message(const std::function<void()>& action);
 
 // Writes a valid dataset into `root`: a one-triangle template, cameras
 // cam00 (train) and cam01 (test), frames smile_000000 (train) and

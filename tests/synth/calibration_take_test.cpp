@@ -15,23 +15,15 @@
 #include "tega/synth/charuco_board.h"
 #include "tega/synth/virtual_studio.h"
 #include "test_support.h"
+#include "ground_truth_json.h"
 
 namespace tega::synth {
 namespace {
 
 namespace fs = std::filesystem;
 
-nlohmann::json read_json(const fs::path& file) {
-  std::ifstream in(file);
-  return nlohmann::json::parse(in);
-}
-
-RigidTransform pose_from_json(const nlohmann::json& rows) {
-  Eigen::Matrix<double, 3, 4> m;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 4; ++c) m(r, c) = rows[r][c];
-  return RigidTransform::from_matrix(m);
-}
+using test::pose_from_json;
+using test::read_json;
 
 TEST(CalibrationTake, OpenCvFindsTheCharucoCornersWhereTheGroundTruthPutsThem) {
   tega::test::TempDir tmp;

@@ -17,6 +17,7 @@
 #include "tega/core/take.h"
 #include "tega/synth/virtual_studio.h"
 #include "test_support.h"
+#include "ground_truth_json.h"
 
 
 namespace tega::synth {
@@ -50,17 +51,8 @@ const fs::path& capture() {
   return rendered.dir;
 }
 
-nlohmann::json read_json(const fs::path& file) {
-  std::ifstream in(file);
-  return nlohmann::json::parse(in);
-}
-
-RigidTransform pose_from_json(const nlohmann::json& rows) {
-  Eigen::Matrix<double, 3, 4> m;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 4; ++c) m(r, c) = rows[r][c];
-  return RigidTransform::from_matrix(m);
-}
+using test::pose_from_json;
+using test::read_json;
 
 // Pixels whose centre lies inside a projected triangle (either winding): an
 // independent, plain rasterization of the ground-truth mesh.

@@ -11,13 +11,12 @@
 
 #include <string>
 #include <vector>
+#include "../tensor_compare.h"
 
 namespace tega::nn {
 namespace {
 
-double relative_error(const at::Tensor& a, const at::Tensor& reference) {
-  return (a.cpu().to(at::kDouble) - reference).norm().item<double>() / reference.norm().item<double>();
-}
+using test::relative_error;
 
 struct Evaluation {
   at::Tensor value, jacobian, value_only;

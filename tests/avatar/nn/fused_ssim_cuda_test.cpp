@@ -12,16 +12,14 @@
 
 #include <cmath>
 #include <vector>
+#include "../tensor_compare.h"
 
 namespace tega::nn {
 namespace {
 
 using Shape = std::vector<int64_t>;
 
-double relative_error(const at::Tensor& a, const at::Tensor& b) {
-  const at::Tensor ad = a.detach().to(at::kCPU, at::kDouble), bd = b.detach().to(at::kCPU, at::kDouble);
-  return (ad - bd).norm().item<double>() / std::max(bd.norm().item<double>(), 1e-300);
-}
+using test::relative_error;
 
 // The largest difference relative to the largest reference value: catches a
 // wrong border that a norm over a large image would average away.

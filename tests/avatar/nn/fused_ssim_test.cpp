@@ -12,16 +12,14 @@
 #include <torch/csrc/autograd/autograd.h>
 
 #include <vector>
+#include "../tensor_compare.h"
 
 namespace tega::nn {
 namespace {
 
 using Shape = std::vector<int64_t>;
 
-double relative_error(const at::Tensor& a, const at::Tensor& b) {
-  const at::Tensor ad = a.detach().to(at::kDouble), bd = b.detach().to(at::kDouble);
-  return (ad - bd).norm().item<double>() / std::max(bd.norm().item<double>(), 1e-300);
-}
+using test::relative_error;
 
 // A target resembling the rendering, as in training: SSIM well inside (0, 1).
 at::Tensor noisy_copy(const at::Tensor& image) { return (image + 0.1 * at::randn_like(image)).clamp(0, 1); }

@@ -9,13 +9,12 @@
 #include <vector>
 
 #include "tega/nn/positional_encoding.h"
+#include "../tensor_compare.h"
 
 namespace tega::nn {
 namespace {
 
-double relative_error(const at::Tensor& a, const at::Tensor& reference) {
-  return (a.cpu().to(at::kDouble) - reference).norm().item<double>() / reference.norm().item<double>();
-}
+using test::relative_error;
 
 struct Encoded {
   EncodedPositions out;

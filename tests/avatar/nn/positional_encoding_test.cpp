@@ -18,7 +18,7 @@ PositionalEncoding test_encoding() {
 }
 
 // uvd over the range training meets: u, v in [0,1], d in [-0.05, 0.2] m.
-at::Tensor random_uvd(int64_t n) {
+at::Tensor uvd_in_training_range(int64_t n) {
   const at::Tensor uv = at::rand({n, 2}, at::kDouble);
   const at::Tensor d = at::rand({n, 1}, at::kDouble) * 0.25 - 0.05;
   return at::cat({uv, d}, 1);
@@ -26,7 +26,7 @@ at::Tensor random_uvd(int64_t n) {
 
 TEST(EncodePositions, MatchesTheDefinitionWithZeroPadding) {
   const PositionalEncoding pe = test_encoding();
-  const at::Tensor uvd = random_uvd(37);
+  const at::Tensor uvd = uvd_in_training_range(37);
   const EncodedPositions fused = encode_positions(pe, uvd, at::kDouble, /*with_derivatives=*/true);
   ASSERT_EQ(fused.encoding.sizes(), (std::vector<int64_t>{37, aligned_width(pe.channels())}));
   ASSERT_EQ(fused.derivatives.sizes(), (std::vector<int64_t>{3, 37, aligned_width(pe.features())}));
@@ -52,7 +52,7 @@ TEST(EncodePositions, MatchesTheDefinitionWithZeroPadding) {
 // derivative output autograd differentiates a second time).
 TEST(EncodePositions, GradientsMatchTheDefinition) {
   const PositionalEncoding pe = test_encoding();
-  const at::Tensor uvd = random_uvd(29);
+  const at::Tensor uvd = uvd_in_training_range(29);
   const at::Tensor weight_encoding = at::randn({29, pe.channels()}, at::kDouble);
   const at::Tensor weight_derivatives = at::randn({3, 29, pe.features()}, at::kDouble);
   for (const bool with_derivatives : {true, false}) {
@@ -75,7 +75,7 @@ TEST(EncodePositions, GradientsMatchTheDefinition) {
 }
 
 TEST(EncodePositions, RejectsAnOutputTypeOtherThanUvdsOnTheCpu) {
-  EXPECT_THROW(encode_positions(test_encoding(), random_uvd(3), at::kFloat, false), c10::Error);
+  EXPECT_THROW(encode_positions(test_encoding(), uvd_in_training_range(3), at::kFloat, false), c10::Error);
   EXPECT_THROW(encode_positions(test_encoding(), at::zeros({3, 2}, at::kDouble), at::kDouble, false), c10::Error);
 }
 

@@ -6,6 +6,7 @@
 #include <torch/cuda.h>
 
 #include "tega/nn/silu_tangents.h"
+#include "../tensor_compare.h"
 
 namespace {
 
@@ -37,9 +38,7 @@ TEST(SiluTangentsCuda, MatchesTheCpu) {
   }
 }
 
-double relative_error(const at::Tensor& a, const at::Tensor& reference) {
-  return (a.to(at::kDouble) - reference).norm().item<double>() / reference.norm().item<double>();
-}
+using tega::test::relative_error;
 
 // The bfloat16 kernels (FieldMLP's mixed precision) against float64 on the
 // CPU, both fed the same bfloat16-representable inputs and output weights:

@@ -74,7 +74,7 @@ TEST_P(CudaParityTest, MatchesCpuInDoubleWithoutDepthInTheLoss) {
   expect_cuda_matches_cpu(random_scene(GetParam()).to(at::kFloat), /*depth_in_loss=*/false);
 }
 
-SceneSpec spec(ColorMode colors, bool antialiased, uint64_t seed) {
+SceneSpec parity_spec(ColorMode colors, bool antialiased, uint64_t seed) {
   SceneSpec s;
   s.colors = colors;
   s.antialiased = antialiased;
@@ -101,8 +101,8 @@ SceneSpec crowded_spec(bool antialiased) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, CudaParityTest,
-                         ::testing::Values(spec(ColorMode::kSh, false, 1), spec(ColorMode::kSh, true, 2),
-                                           spec(ColorMode::kRgb, false, 3), spec(ColorMode::kPerCameraRgb, true, 4),
+                         ::testing::Values(parity_spec(ColorMode::kSh, false, 1), parity_spec(ColorMode::kSh, true, 2),
+                                           parity_spec(ColorMode::kRgb, false, 3), parity_spec(ColorMode::kPerCameraRgb, true, 4),
                                            crowded_spec(false), crowded_spec(true)));
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include "tega/trainer/spherical_harmonics.h"
 #include "test_support.h"
 #include "tiny_avatar.h"
+#include "../tensor_compare.h"
 
 namespace {
 
@@ -45,10 +46,7 @@ struct Fixture : test::TinyAvatar {
   }
 };
 
-double relative_error(const at::Tensor& a, const at::Tensor& reference) {
-  return (a.to(at::kDouble) - reference.to(at::kDouble)).norm().item<double>() /
-         reference.to(at::kDouble).norm().item<double>();
-}
+using test::relative_error;
 
 // pose() folds the shading multiplier into the SH coefficients that the
 // rasterizer evaluates; this holds it against colours computed the direct

@@ -4,15 +4,13 @@
 #include <gtest/gtest.h>
 
 #include "tega/trainer/adam.h"
+#include "../tensor_compare.h"
 
 namespace {
 
 using tega::trainer::Adam;
 
-double relative_error(const at::Tensor& a, const at::Tensor& reference) {
-  const at::Tensor r = reference.to(at::kCPU, at::kDouble);
-  return (a.to(at::kCPU, at::kDouble) - r).norm().item<double>() / r.norm().item<double>();
-}
+using tega::test::relative_error;
 
 TEST(AdamCuda, MatchesTheCpuInDouble) {
   if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";

@@ -14,7 +14,7 @@ namespace {
 
 using test::row_relative_error;
 
-struct Fixture {
+struct MappedSeamedMesh {
   Mesh mesh = test::seamed_mesh();
   UvTriangleLookup lookup{mesh, {64, 0.1}};
   PosedMesh posed = pose(lookup, test::to_tensor(test::posed_vertices(mesh)));
@@ -51,7 +51,7 @@ at::Tensor with_depth(const at::Tensor& uv, unsigned seed) {
   return at::cat({uv, (at::rand({uv.size(0), 1}, generator, at::kDouble) * 2 - 1) * 0.1}, 1);
 }
 
-void expect_same_mapping(const Fixture& s, const at::Tensor& uvd, const at::Tensor& bound) {
+void expect_same_mapping(const MappedSeamedMesh& s, const at::Tensor& uvd, const at::Tensor& bound) {
   const int64_t n = uvd.size(0);
   const at::Tensor wx = at::randn({n, 3}, at::kDouble), wj = at::randn({n, 3, 3}, at::kDouble);
   const std::pair<at::Tensor, at::Tensor> losses[] = {{wx, wj}, {wx, at::Tensor()}, {at::Tensor(), wj}};
@@ -68,7 +68,7 @@ void expect_same_mapping(const Fixture& s, const at::Tensor& uvd, const at::Tens
 }
 
 TEST(FusedUvdMap, MatchesTheComposedOpsThroughTheLookup) {
-  Fixture s;
+  MappedSeamedMesh s;
   // Points inside their triangles (edges included), and uniformly random
   // ones, most of them off the layout and projected onto it.
   const auto inside = test::points_in_faces(s.mesh, s.valid_faces(), 5, 0.0, 1).uv;
@@ -77,7 +77,7 @@ TEST(FusedUvdMap, MatchesTheComposedOpsThroughTheLookup) {
 }
 
 TEST(FusedUvdMap, MatchesTheComposedOpsWhenBound) {
-  Fixture s;
+  MappedSeamedMesh s;
   const auto points = test::points_in_faces(s.mesh, s.valid_faces(), 5, 0.0, 4);
   const auto face = at::tensor(std::vector<int64_t>(points.face.begin(), points.face.end()));
   // Moved off their triangles, which then extrapolate affinely.
@@ -86,7 +86,7 @@ TEST(FusedUvdMap, MatchesTheComposedOpsWhenBound) {
 }
 
 TEST(FusedUvdMap, FloatMatchesDouble) {
-  Fixture s;
+  MappedSeamedMesh s;
   const int64_t n = 100000;
   const auto random = at::rand({n, 2}, at::detail::createCPUGenerator(7), at::kDouble) * 1.1 - 0.05;
   // Both precisions in the triangles that the double lookup picks, at its projected uv.
@@ -103,7 +103,7 @@ TEST(FusedUvdMap, FloatMatchesDouble) {
 }
 
 TEST(FusedUvdMap, RejectsBoundTrianglesOutOfRange) {
-  Fixture s;
+  MappedSeamedMesh s;
   const auto uvd = at::zeros({2, 3}, at::kDouble);
   EXPECT_THROW(uvd_to_world(uvd, s.posed, s.lookup, at::tensor({int64_t(0), s.lookup.num_triangles()})), c10::Error);
   EXPECT_THROW(uvd_to_world(uvd, s.posed, s.lookup, at::tensor({int64_t(-1), int64_t(0)})), c10::Error);

@@ -48,7 +48,7 @@ void expect_close(const at::Tensor& actual, const at::Tensor& expected, double r
   EXPECT_LT((actual - expected).abs().max().item<double>(), relative * scale);
 }
 
-struct Fixture {
+struct PosedSeamedMesh {
   Mesh mesh = seamed_mesh();
   UvTriangleLookup lookup{mesh, {64, 0.1}};
   Eigen::MatrixXd vertices = test::posed_vertices(mesh);
@@ -56,12 +56,12 @@ struct Fixture {
 };
 
 TEST(UvdMap, VertexNormalsAreAreaWeightedAcrossSeams) {
-  Fixture s;
+  PosedSeamedMesh s;
   EXPECT_TRUE(s.posed.normals.allclose(test::to_tensor(test::reference_normals(s.vertices, s.mesh)), 0, 1e-12));
 }
 
 TEST(UvdMap, PositionsFollowTheDefinition) {
-  Fixture s;
+  PosedSeamedMesh s;
   const auto points = test::points_in_faces(s.mesh, valid_faces(s.lookup), 5, 0.0, 1);
   const auto uvd = with_depth(points.uv, 0.1, 2);
   const UvdMapping map = uvd_to_world(uvd, s.posed, s.lookup);
@@ -80,7 +80,7 @@ TEST(UvdMap, PositionsFollowTheDefinition) {
 }
 
 TEST(UvdMap, JacobianMatchesFiniteDifferences) {
-  Fixture s;
+  PosedSeamedMesh s;
   // Well inside the triangles, and within 1e-3 (in barycentrics) of their edges, seams included.
   for (auto [margin, h] : {std::pair{0.02, 1e-6}, std::pair{1e-3, 1e-8}}) {
     const auto points = test::points_in_faces(s.mesh, valid_faces(s.lookup), 5, margin, 3);
@@ -91,7 +91,7 @@ TEST(UvdMap, JacobianMatchesFiniteDifferences) {
 }
 
 TEST(UvdMap, AutogradGradientIsTheJacobian) {
-  Fixture s;
+  PosedSeamedMesh s;
   const auto points = test::points_in_faces(s.mesh, valid_faces(s.lookup), 3, 0.0, 5);
   const auto uvd = with_depth(points.uv, 0.1, 6);
   const auto reference = uvd_to_world(uvd, s.posed, s.lookup).jacobian;
@@ -104,7 +104,7 @@ TEST(UvdMap, AutogradGradientIsTheJacobian) {
 
 // ∂J/∂uvd reaches the covariance J Σ Jᵀ: autograd through J matches finite differences.
 TEST(UvdMap, JacobianDerivativeMatchesFiniteDifferences) {
-  Fixture s;
+  PosedSeamedMesh s;
   const auto points = test::points_in_faces(s.mesh, valid_faces(s.lookup), 5, 0.02, 7);
   const auto uvd = with_depth(points.uv, 0.1, 8);
   const auto weight = at::randn({uvd.size(0), 3, 3}, at::kDouble);
@@ -124,7 +124,7 @@ TEST(UvdMap, JacobianDerivativeMatchesFiniteDifferences) {
 
 // Queries outside every triangle: mapped through their closest valid point.
 TEST(UvdMap, ProjectedPointsUseTheirClosestValidPoint) {
-  Fixture s;
+  PosedSeamedMesh s;
   const auto uv = at::rand({4000, 2}, at::kDouble) * 1.1 - 0.05;
   const UvHit hit = s.lookup.lookup(uv);
   const auto outside = hit.distance > 1e-3;
@@ -166,7 +166,7 @@ TEST(UvdMap, ProjectedPointsUseTheirClosestValidPoint) {
 }
 
 TEST(UvdMap, BindingKeepsTheGivenTriangleAndExtrapolates) {
-  Fixture s;
+  PosedSeamedMesh s;
   const auto points = test::points_in_faces(s.mesh, valid_faces(s.lookup), 2, 0.05, 10);
   const auto face = at::tensor(std::vector<int64_t>(points.face.begin(), points.face.end()));
   const auto uvd = with_depth(points.uv, 0.1, 11);
