@@ -86,6 +86,7 @@ TEST(StudioTracking, TracksTegasOwnMeshesWithinTheTargets) {
   mvs_options.surface.threads = 1;
   mvs_options.surface.poisson_depth = 8;
   mvs_options.patch_match.iterations = 3;
+  mvs_options.patch_match.source_views = 4;
   mvs_options.patch_match.geometric_iterations = 1;
   mvs::MvsRequest mvs_request;
   mvs_request.capture = capture;
