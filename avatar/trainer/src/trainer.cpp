@@ -9,8 +9,10 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <set>
 #include <sstream>
 
 #include "tega/core/error.h"
@@ -94,9 +96,10 @@ double exponential(double from, double to, double t) { return from * std::pow(to
 // One training run: the model, its optimizer and everything a checkpoint holds.
 class Run {
  public:
-  Run(const fs::path& dataset_dir, const fs::path& run_dir, const TrainOptions& options, bool resume)
+  Run(const fs::path& dataset_dir, const fs::path& run_dir, const TrainOptions& options, const RunControl& control)
       : options_(options),
         run_dir_(run_dir),
+        poisoned_iterations_(control.poisoned_iterations.begin(), control.poisoned_iterations.end()),
         device_(options.device),
         dataset_(read_dataset(dataset_dir)),
         model_((validate_dataset(dataset_), dataset_), options, device_),
@@ -114,7 +117,7 @@ class Run {
     }
     background_ = at::tensor(options_.background, at::kFloat).to(device_);
 
-    if (resume) {
+    if (control.resume) {
       restore_latest();
     } else {
       model_.gaussians = initialise_gaussians(model_.lookup(), options_.initial_gaussians, model_.metres_per_uv(),
@@ -123,6 +126,7 @@ class Run {
       register_parameters();
       stats_ = splat::MeanGradientStats::zeros(model_.gaussians.uvd);
       max_world_std_ = at::zeros({model_.gaussians.size()}, background_.options());
+      save();  // what a NaN/Inf before the first periodic checkpoint rolls back to
     }
     logging::info("dataset %s: %zu frames, %zu cameras; %zu training views, template %d vertices; %lld Gaussians",
                   dataset_dir.c_str(), dataset_.frames.size(), dataset_.rig.cameras.size(), train_views_.size(),
@@ -137,13 +141,19 @@ class Run {
     const auto start = std::chrono::steady_clock::now();
     auto first_done = start;
     const int64_t first = iteration_;
+    auto rate_start = start;  // the progress line's rate counts from here (a roll-back restarts it)
+    int64_t rate_first = first;
     double window_loss = 0, window_psnr = 0;
     int window = 0;
     TrainSummary summary;
-    // Adds a finished step's values to the log window; stops on NaN/Inf.
+    std::optional<StepValues> non_finite;
+    // Adds a finished step's values to the log window, or notes a NaN/Inf.
     const auto take = [&](const std::optional<StepValues>& values) {
       if (!values) return;
-      if (!values->finite) report_non_finite(*values);
+      if (!values->finite) {
+        if (!non_finite) non_finite = values;
+        return;
+      }
       window_loss += values->loss;
       window_psnr += -10.0 * std::log10(std::max(values->mse, 1e-12));
       ++window;
@@ -157,9 +167,21 @@ class Run {
       const bool log_due = iteration_ % options_.log_every == 0 || iteration_ == last;
       const bool checkpoint_due = iteration_ % options_.checkpoint_every == 0 && iteration_ < last;
       if (log_due || checkpoint_due) take(readout_.pop());
+      if (non_finite) {
+        roll_back(*non_finite);
+        non_finite.reset();
+        loader.seek(iteration_);
+        rate_first = iteration_;
+        rate_start = std::chrono::steady_clock::now();
+        window_loss = window_psnr = 0;
+        window = 0;
+        continue;
+      }
       if (log_due) {
-        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        const double rate = static_cast<double>(iteration_ - first) / std::max(seconds, 1e-9);
+        const auto now = std::chrono::steady_clock::now();
+        const double seconds = std::chrono::duration<double>(now - start).count();
+        const double rate = static_cast<double>(iteration_ - rate_first) /
+                            std::max(std::chrono::duration<double>(now - rate_start).count(), 1e-9);
         summary.final_loss = window_loss / window;
         summary.train_psnr = window_psnr / window;
         metrics_.push_back({iteration_, summary.final_loss, summary.train_psnr, model_.gaussians.size(), seconds});
@@ -251,6 +273,7 @@ class Run {
     const double vgg_weight = schedules::vgg_weight(options_.loss, iteration_, options_.iterations);
     if (vgg_ && vgg_weight > 0) loss = loss + vgg_weight * (*vgg_)(rendered.unsqueeze(0), target.unsqueeze(0));
     if (smoothness.defined()) loss = loss + smoothness;
+    if (poisoned_iterations_.erase(iteration_ + 1)) loss = loss * std::numeric_limits<double>::quiet_NaN();
     const at::Tensor mse = (rendered.detach() - target).pow(2).mean();
 
     profiler_.section("backward");
@@ -305,18 +328,45 @@ class Run {
     return at::stack(finite).all();
   }
 
-  [[noreturn]] void report_non_finite(const StepValues& values) const {
-    throw Error("iteration " + std::to_string(values.iteration) + ": the loss or a gradient is NaN/Inf (camera " +
-                dataset_.rig.cameras[values.view.camera].name + ", frame " + dataset_.frames[values.view.frame].id +
-                "); training stopped, the last checkpoint (iteration " + std::to_string(saved_iteration_) +
-                ") is intact");
+  // A NaN/Inf step rolls the run back to its last checkpoint and lowers every
+  // learning rate, once; a second one stops training (nothing non-finite is
+  // ever saved: the loop checks each step before it saves).
+  void roll_back(const StepValues& values) {
+    const std::string what = "iteration " + std::to_string(values.iteration) +
+                             ": the loss or a gradient is NaN/Inf (camera " +
+                             dataset_.rig.cameras[values.view.camera].name + ", frame " +
+                             dataset_.frames[values.view.frame].id + ")";
+    if (rolled_back_) {
+      throw Error(what + " again after a roll-back with the learning rates x" + format_number(learning_rate_scale_) +
+                  "; training stopped, the last checkpoint (iteration " + std::to_string(saved_iteration_) +
+                  ") is intact");
+    }
+    const double scale = learning_rate_scale_ * options_.rollback_learning_rate_factor;
+    logging::warn("%s; rolling back to the checkpoint of iteration %lld, learning rates x%s from there", what.c_str(),
+                  static_cast<long long>(saved_iteration_), format_number(scale).c_str());
+    restore_latest();
+    learning_rate_scale_ = scale;
+    rolled_back_ = true;
+    readout_.pop();  // the pending step ran on the bad parameters
+  }
+
+  static std::string format_number(double x) {
+    std::ostringstream out;
+    out << x;
+    return out.str();
   }
 
   void update_learning_rates() {
     const double t = static_cast<double>(iteration_) / static_cast<double>(std::max<int64_t>(1, options_.iterations - 1));
     const auto& lr = options_.learning_rates;
-    adam_.group("uvd").learning_rate = exponential(lr.position, lr.position_final, t);
-    const double network_lr = exponential(lr.network, lr.network_final, t);
+    const double s = learning_rate_scale_;
+    adam_.group("uvd").learning_rate = s * exponential(lr.position, lr.position_final, t);
+    adam_.group("log_scale").learning_rate = s * lr.scale;
+    adam_.group("rotation").learning_rate = s * lr.rotation;
+    adam_.group("sh_dc").learning_rate = s * lr.sh_dc;
+    adam_.group("sh_rest").learning_rate = s * lr.sh_rest;
+    adam_.group("opacity_logit").learning_rate = s * lr.opacity;
+    const double network_lr = s * exponential(lr.network, lr.network_final, t);
     for (auto& name : network_groups_) adam_.group(name).learning_rate = network_lr;
   }
 
@@ -369,6 +419,8 @@ class Run {
     c.tensors["densify.max_world_std"] = max_world_std_;
     c.tensors["trainer.iteration"] = at::tensor({iteration_}, at::kLong);
     c.tensors["trainer.rng_state"] = generator_.get_state();
+    c.tensors["trainer.learning_rate_scale"] = at::tensor({learning_rate_scale_}, at::kDouble);
+    c.tensors["trainer.rolled_back"] = at::tensor({int64_t{rolled_back_}}, at::kLong);
     c.metadata["options"] = options_to_yaml(options_);
     // Kept until this one is written whole: killed in between, the run
     // resumes from it.
@@ -410,6 +462,11 @@ class Run {
     stats_.visible_count = tensor("densify.visible_count");
     max_world_std_ = tensor("densify.max_world_std");
     generator_.set_state(tensor("trainer.rng_state").cpu());
+    // Absent from checkpoints written before roll-backs existed.
+    const auto scale = c.tensors.find("trainer.learning_rate_scale");
+    learning_rate_scale_ = scale == c.tensors.end() ? 1.0 : scale->second.item<double>();
+    const auto rolled_back = c.tensors.find("trainer.rolled_back");
+    rolled_back_ = rolled_back != c.tensors.end() && rolled_back->second.item<int64_t>() != 0;
     iteration_ = saved_iteration_ = c.iteration();
     metrics_ = read_metrics(run_dir_ / kMetrics, iteration_);
     logging::info("resumed %s at iteration %lld", file.c_str(), static_cast<long long>(iteration_));
@@ -451,6 +508,9 @@ class Run {
   StepProfiler profiler_;
   int64_t iteration_ = 0;
   int64_t saved_iteration_ = 0;
+  double learning_rate_scale_ = 1.0;  // lowered by a roll-back
+  bool rolled_back_ = false;
+  std::set<int64_t> poisoned_iterations_;
   StepReadout readout_;
 };
 
@@ -465,14 +525,16 @@ TrainSummary train(const fs::path& dataset, const fs::path& run, TrainOptions op
   } else if (has_checkpoint && !control.overwrite) {
     throw Error(run, "already holds a run (pass --resume to continue it, or --force to start over)");
   } else {
-    fs::remove(run / kPreviousCheckpoint);  // the run it belonged to is over
+    // The run they belonged to is over (--force).
+    fs::remove(run / kCheckpoint);
+    fs::remove(run / kPreviousCheckpoint);
   }
   fs::create_directories(run);
   write_text_atomic(run / kOptions, options_to_yaml(options));
 
   // The networks' initial weights come from libtorch's global generator.
   at::manual_seed(static_cast<uint64_t>(options.seed));
-  Run training(dataset, run, options, control.resume);
+  Run training(dataset, run, options, control);
   TrainSummary summary = training.train(control.stop_at);
 
   const nlohmann::json report = {{"dataset", fs::absolute(dataset).string()},

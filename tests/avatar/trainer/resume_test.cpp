@@ -1,6 +1,7 @@
 #include <ATen/ATen.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <sstream>
 
 #include "tega/core/error.h"
@@ -127,9 +128,76 @@ TEST(Trainer, ExistingRunIsNotOverwrittenByAccident) {
   }
 }
 
-// An absurd colour step size makes the second step's loss non-finite. The
-// run stops with an error naming it, and the checkpoint it leaves is the last
-// finite one.
+// Every learning rate of `options` times `factor`.
+TrainOptions scaled_learning_rates(TrainOptions options, double factor) {
+  auto& lr = options.learning_rates;
+  for (double* rate : {&lr.position, &lr.position_final, &lr.sh_dc, &lr.sh_rest, &lr.opacity, &lr.scale, &lr.rotation,
+                       &lr.network, &lr.network_final}) {
+    *rate *= factor;
+  }
+  return options;
+}
+
+// A NaN loss at iteration 5 rolls the run back to its checkpoint of
+// iteration 3; it goes on with every learning rate halved, and ends where a
+// run stopped at 3 and resumed with halved learning rates ends.
+TEST(Trainer, ANonFiniteStepRollsBackToTheLastCheckpointWithLowerLearningRates) {
+  tega::test::TempDir tmp;
+  tega::test::write_tiny_dataset(tmp / "data");
+  TrainOptions options = tiny_options();
+  options.checkpoint_every = 3;
+  ASSERT_EQ(options.rollback_learning_rate_factor, 0.5);
+  const TrainSummary rolled = train(tmp / "data", tmp / "rolled", options, {.poisoned_iterations = {5}});
+  EXPECT_EQ(rolled.iterations, 6);
+  const Checkpoint last = read_checkpoint(tmp / "rolled/checkpoint.safetensors");
+  EXPECT_EQ(last.tensors.at("trainer.learning_rate_scale").item<double>(), 0.5);
+
+  train(tmp / "data", tmp / "reference", options, {.stop_at = 3});
+  train(tmp / "data", tmp / "reference", scaled_learning_rates(options, 0.5), {.resume = true});
+  expect_same_parameters(tmp / "reference", tmp / "rolled");
+
+  // ... which is not where the run would have ended without the NaN.
+  train(tmp / "data", tmp / "straight", options, {});
+  const Checkpoint straight = read_checkpoint(tmp / "straight/checkpoint.safetensors");
+  double largest_difference = 0;
+  for (const auto& [name, tensor] : last.tensors)
+    if (name.rfind("network.", 0) == 0)
+      largest_difference = std::max(largest_difference, (tensor - straight.tensors.at(name)).abs().max().item<double>());
+  EXPECT_GT(largest_difference, 1e-6);
+}
+
+// Before the first periodic checkpoint, the roll-back goes to the start.
+TEST(Trainer, ANonFiniteFirstStepRollsBackToTheStart) {
+  tega::test::TempDir tmp;
+  tega::test::write_tiny_dataset(tmp / "data");
+  TrainOptions options = tiny_options();
+  train(tmp / "data", tmp / "rolled", options, {.poisoned_iterations = {1}});
+  train(tmp / "data", tmp / "reference", scaled_learning_rates(options, 0.5), {});
+  expect_same_parameters(tmp / "reference", tmp / "rolled");
+}
+
+// A second NaN after the roll-back stops training, naming both the step and
+// the intact checkpoint.
+TEST(Trainer, ASecondNonFiniteStepStopsTraining) {
+  tega::test::TempDir tmp;
+  tega::test::write_tiny_dataset(tmp / "data");
+  TrainOptions options = tiny_options();
+  options.checkpoint_every = 2;
+  try {
+    train(tmp / "data", tmp / "run", options, {.poisoned_iterations = {3, 5}});
+    FAIL() << "expected an error";
+  } catch (const tega::Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("iteration 5: the loss or a gradient is NaN/Inf"), std::string::npos) << message;
+    EXPECT_NE(message.find("again after a roll-back"), std::string::npos) << message;
+    EXPECT_NE(message.find("the last checkpoint (iteration 4) is intact"), std::string::npos) << message;
+  }
+  EXPECT_EQ(read_checkpoint(tmp / "run/checkpoint.safetensors").iteration(), 4);
+}
+
+// An absurd colour step size makes the second step's loss non-finite, and
+// again after the roll-back. The run stops with an error naming it, and the
+// checkpoint it leaves is the last finite one.
 TEST(Trainer, NonFiniteStepStopsTrainingAndKeepsTheLastFiniteCheckpoint) {
   tega::test::TempDir tmp;
   tega::test::write_tiny_dataset(tmp / "data");

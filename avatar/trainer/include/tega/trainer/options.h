@@ -99,6 +99,7 @@ struct TrainOptions {
   std::string binding = "uvd";                   // uvd (TeGA) or triangle (GaussianAvatars)
   bool antialiased = false;
   int64_t checkpoint_every = 5000;
+  double rollback_learning_rate_factor = 0.5;  // after a NaN/Inf step
   int64_t log_every = 10;
   int loader_threads = 4;
   int prefetch = 8;
@@ -126,7 +127,10 @@ struct TrainOptions {
     v("dynamic_shading", dynamic_shading, "Learn the dynamic shading. false: the 'no shading' ablation (both false: 'no network').");
     v("binding", binding, "uvd: Gaussians move freely across triangles (TeGA); triangle: each keeps its triangle (GaussianAvatars).");
     v("antialiased", antialiased, "Mip-Splatting-style antialiased rasterization.");
-    v("checkpoint_every", checkpoint_every, "Iterations between checkpoints (plus one at the end).");
+    v("checkpoint_every", checkpoint_every, "Iterations between checkpoints (plus one at the start and one at the end).");
+    v("rollback_learning_rate_factor", rollback_learning_rate_factor,
+      "A step whose loss or gradients hold NaN/Inf rolls training back to its last checkpoint, once, and every "
+      "learning rate is multiplied by this from there on; a second such step stops training.");
     v("log_every", log_every, "Iterations between progress lines.");
     v("loader_threads", loader_threads, "Threads decoding training images ahead of use.");
     v("prefetch", prefetch, "Training views decoded ahead of use.");

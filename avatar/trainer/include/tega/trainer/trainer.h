@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "tega/trainer/options.h"
 
@@ -40,6 +41,9 @@ struct RunControl {
   // Stop with a checkpoint after this iteration (0: run to the end); the
   // schedules still follow TrainOptions::iterations. For training in slices.
   int64_t stop_at = 0;
+  // Fault injection, for tests: the loss of each of these iterations
+  // (1-based) is made NaN the first time the run reaches it.
+  std::vector<int64_t> poisoned_iterations;
 };
 
 // Validates the dataset before anything else (throws tega::Error naming the
