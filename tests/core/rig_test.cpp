@@ -73,16 +73,7 @@ std::vector<std::string> words_of(const std::string& line) {
   return words;
 }
 
-// The message of the tega::Error that `action` throws ("" and a failure when none).
-std::string error_of(const std::function<void()>& action) {
-  try {
-    action();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no tega::Error thrown";
-  return {};
-}
+using test::error_message;
 
 TEST(Rig, LooksCamerasUpByName) {
   const Rig rig = studio_rig();
@@ -90,7 +81,7 @@ TEST(Rig, LooksCamerasUpByName) {
   EXPECT_TRUE(rig.contains("cam01"));
   EXPECT_FALSE(rig.contains("cam03"));
   EXPECT_EQ(rig.camera("cam02").width, 2080);
-  EXPECT_NE(error_of([&] { rig.camera("cam03"); }).find("'cam03'"), std::string::npos);
+  EXPECT_NE(error_message([&] { rig.camera("cam03"); }).find("'cam03'"), std::string::npos);
 }
 
 TEST(RigJson, RoundTripIsExact) {
@@ -118,7 +109,7 @@ class RigJsonErrors : public ::testing::Test {
     json doc = doc_;
     edit(doc);
     test::write_text(dir_ / "bad.json", doc.dump(2));
-    const std::string message = error_of([&] { read_rig_json(dir_ / "bad.json"); });
+    const std::string message = error_message([&] { read_rig_json(dir_ / "bad.json"); });
     EXPECT_NE(message.find((dir_ / "bad.json").string()), std::string::npos) << message;
     return message;
   }
@@ -173,7 +164,7 @@ TEST_F(RigJsonErrors, InvalidValuesNameTheCameraAndField) {
 
 TEST_F(RigJsonErrors, NotJson) {
   test::write_text(dir_ / "bad.json", "{\"format\": \"tega-rig\",");
-  EXPECT_CONTAINS(error_of([&] { read_rig_json(dir_ / "bad.json"); }), "not valid JSON");
+  EXPECT_CONTAINS(error_message([&] { read_rig_json(dir_ / "bad.json"); }), "not valid JSON");
 }
 
 TEST(RigWriters, RefuseAnInvalidRigAndWriteNothing) {
@@ -288,7 +279,7 @@ TEST(RigColmap, ImageNameSuffixAndSparsePointsForDenseWorkspaces) {
   EXPECT_EQ(points3d, (std::vector<std::string>{"1 100 200 300 0 0 0 0 1 0 3 0", "2 -100 0 1000 0 0 0 0 2 0 3 1"}));
 
   points[1].observations[0].first = 3;
-  EXPECT_CONTAINS(error_of([&] { write_colmap_text(rig, dir / "bad", 1.0, ".png", points); }),
+  EXPECT_CONTAINS(error_message([&] { write_colmap_text(rig, dir / "bad", 1.0, ".png", points); }),
                   "point 2 is observed by camera index 3, but the rig has 3 cameras");
 }
 
@@ -306,27 +297,27 @@ TEST(RigColmap, ErrorsNameFileAndLine) {
   test::write_text(dir / "cameras.txt", "# cameras\n1 PINHOLE 640 480 500 500 320 240\n"
                                         "2 OPENCV_FISHEYE 640 480 500 500 320 240 0 0 0 0\n");
   test::write_text(dir / "images.txt", "1 1 0 0 0 0 0 0 1 a\n\n");
-  const std::string model = error_of([&] { read_colmap_text(dir.path()); });
+  const std::string model = error_message([&] { read_colmap_text(dir.path()); });
   EXPECT_CONTAINS(model, (dir / "cameras.txt").string() + ": line 3: unsupported camera model "
                                                           "'OPENCV_FISHEYE'");
 
   test::write_text(dir / "cameras.txt", "1 PINHOLE 640 480 500 500 320\n");
-  EXPECT_CONTAINS(error_of([&] { read_colmap_text(dir.path()); }),
+  EXPECT_CONTAINS(error_message([&] { read_colmap_text(dir.path()); }),
                   "line 1: camera model PINHOLE takes 4 parameters, found 3");
 
   test::write_text(dir / "cameras.txt", "1 PINHOLE 640 480 500 500 320 240\n");
   test::write_text(dir / "images.txt", "1 1 0 0 0 0 0 0 1 a\n\n2 1 0 0 0 0 0 0 3 b\n\n");
-  EXPECT_CONTAINS(error_of([&] { read_colmap_text(dir.path()); }),
+  EXPECT_CONTAINS(error_message([&] { read_colmap_text(dir.path()); }),
                   (dir / "images.txt").string() + ": line 3: CAMERA_ID 3 is not in cameras.txt");
 
-  EXPECT_CONTAINS(error_of([&] { read_colmap_text(dir.path(), 0.0); }), "metres_per_unit");
+  EXPECT_CONTAINS(error_message([&] { read_colmap_text(dir.path(), 0.0); }), "metres_per_unit");
 }
 
 TEST(RigColmap, RefusesSkew) {
   test::TempDir dir;
   Rig rig = studio_rig();
   rig.cameras[1].K(0, 1) = 0.5;
-  EXPECT_CONTAINS(error_of([&] { write_colmap_text(rig, dir / "sparse"); }),
+  EXPECT_CONTAINS(error_message([&] { write_colmap_text(rig, dir / "sparse"); }),
                   "camera 'cam01': COLMAP has no skew");
 }
 
@@ -392,7 +383,7 @@ class RigKrtErrors : public ::testing::Test {
   // The error reading `text` as a KRT file; it always names the file.
   std::string error_reading(const std::string& text) {
     test::write_text(dir_ / "bad", text);
-    const std::string message = error_of([&] { read_krt(dir_ / "bad", 1334, 2048); });
+    const std::string message = error_message([&] { read_krt(dir_ / "bad", 1334, 2048); });
     EXPECT_EQ(message.rfind((dir_ / "bad").string() + ": line ", 0), 0u) << message;
     return message;
   }
@@ -446,7 +437,7 @@ TEST_F(RigKrtErrors, MissingBlankLineBetweenCameras) {
 
 TEST_F(RigKrtErrors, EmptyFileHasNoCameras) {
   test::write_text(dir_ / "empty", "\n\n");
-  EXPECT_CONTAINS(error_of([&] { read_krt(dir_ / "empty", 1334, 2048); }), "no cameras");
+  EXPECT_CONTAINS(error_message([&] { read_krt(dir_ / "empty", 1334, 2048); }), "no cameras");
 }
 
 TEST(RigFormats, JsonToColmapToKrtToJsonPreservesEverything) {
