@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <ostream>
 #include <vector>
 
 namespace tega::splat::test {
@@ -30,6 +31,15 @@ struct SceneSpec {
   double spread = 0.7;                        // means uniform in [-spread, spread]³
   uint64_t seed = 1;
 };
+
+// How GoogleTest names a scene in parameterised tests (ctest lists them by
+// it): its defining choices, instead of the struct's raw bytes.
+inline void PrintTo(const SceneSpec& spec, std::ostream* out) {
+  const char* colors = spec.colors == ColorMode::kSh ? "sh" : spec.colors == ColorMode::kRgb ? "rgb" : "camera_rgb";
+  *out << colors;
+  if (spec.colors == ColorMode::kSh) *out << spec.sh_degree;
+  *out << (spec.antialiased ? "_antialiased" : "") << "_" << spec.gaussians << "_gaussians_seed" << spec.seed;
+}
 
 struct Scene {
   at::Tensor means, covariances, colors, opacities, background;
