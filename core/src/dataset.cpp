@@ -72,7 +72,49 @@ void check_split_names(const Dataset& d, const DatasetSplit& split, const char* 
   }
 }
 
+// `missing_images` and `dropped_frames`: optional (absent from datasets made
+// before degraded captures were ingested), checked against frames and rig.
+json optional_list(const json& manifest, const char* key, const fs::path& file) {
+  if (!manifest.contains(key)) return json::array();
+  const json& list = manifest.at(key);
+  if (!list.is_array()) throw Error(file, std::string("'") + key + "' must be a list");
+  for (const auto& entry : list)
+    if (!entry.is_object()) throw Error(file, std::string("every entry of '") + key + "' must be an object");
+  return list;
+}
+
+std::string reason_of(const json& entry, const fs::path& file, const std::string& where) {
+  return entry.contains("reason") ? field<std::string>(entry, "reason", file, where) : "";
+}
+
+void read_gaps(Dataset& d, const json& manifest, const fs::path& file) {
+  std::set<std::string> frames;
+  for (const auto& f : d.frames) frames.insert(f.id);
+  std::set<std::pair<std::string, std::string>> seen;
+  for (const auto& entry : optional_list(manifest, "missing_images", file)) {
+    MissingImage missing{field<std::string>(entry, "camera", file, "a missing image"),
+                         field<std::string>(entry, "frame", file, "a missing image"),
+                         reason_of(entry, file, "a missing image")};
+    const std::string where = "missing image (camera '" + missing.camera + "', frame '" + missing.frame + "')";
+    if (!frames.count(missing.frame)) throw Error(file, where + " names an unknown frame");
+    if (!d.rig.contains(missing.camera)) throw Error(file, where + " names a camera that is not in the rig");
+    if (!seen.insert({missing.camera, missing.frame}).second) throw Error(file, where + " is recorded twice");
+    d.missing_images.push_back(std::move(missing));
+  }
+  for (const auto& entry : optional_list(manifest, "dropped_frames", file)) {
+    DroppedFrame dropped{field<std::string>(entry, "frame", file, "a dropped frame"),
+                         reason_of(entry, file, "a dropped frame")};
+    if (frames.count(dropped.frame)) throw Error(file, "frame '" + dropped.frame + "' is both kept and dropped");
+    d.dropped_frames.push_back(std::move(dropped));
+  }
+}
+
 }  // namespace
+
+bool Dataset::has_image(const std::string& camera, const std::string& frame_id) const {
+  return std::none_of(missing_images.begin(), missing_images.end(),
+                      [&](const MissingImage& m) { return m.camera == camera && m.frame == frame_id; });
+}
 
 fs::path Dataset::mesh_path(const std::string& frame_id) const { return root / "meshes" / (frame_id + ".bin"); }
 
@@ -90,7 +132,7 @@ Vertices Dataset::load_mesh(const std::string& frame_id) const {
   return read_vertices_bin(mesh_path(frame_id), template_mesh.num_vertices());
 }
 
-Dataset read_dataset(const fs::path& root) {
+static Dataset read_dataset_fields(const fs::path& root) {
   const fs::path file = root / kManifest;
   if (!fs::exists(file)) throw Error(root, "is not a tega dataset (no dataset.json)");
   const json manifest = detail::read_json_file(file);
@@ -137,7 +179,18 @@ Dataset read_dataset(const fs::path& root) {
   d.test = split_from_json(manifest, "test", file);
   check_split_names(d, d.train, "train", file);
   check_split_names(d, d.test, "test", file);
+  read_gaps(d, manifest, file);
   return d;
+}
+
+Dataset read_dataset(const fs::path& root) {
+  // value() and at() throw nlohmann's exceptions for a value of the wrong
+  // type (a manifest that is a number, "images": 5): the user gets tega's.
+  try {
+    return read_dataset_fields(root);
+  } catch (const json::exception& e) {
+    throw Error(root / kManifest, std::string("is malformed: ") + e.what());
+  }
 }
 
 void validate_dataset(const Dataset& d) {
@@ -160,8 +213,11 @@ void validate_dataset(const Dataset& d) {
     }
     for (const auto& cam : cameras) {
       const Camera& camera = d.rig.camera(cam);
+      if (!d.has_image(cam, frame_id)) continue;  // its producer left it out and said so
       const fs::path image = d.image_path(cam, frame_id);
-      if (!fs::exists(image)) throw Error(image, "is missing (camera '" + cam + "', frame '" + frame_id + "')");
+      if (!fs::exists(image))
+        throw Error(image, "is missing (camera '" + cam + "', frame '" + frame_id +
+                               "'), and dataset.json's missing_images does not record it");
       const ImageHeader header = read_image_header(image);
       if (header.width != camera.width || header.height != camera.height) {
         throw Error(image, "is " + std::to_string(header.width) + "x" + std::to_string(header.height) +
@@ -174,7 +230,8 @@ void validate_dataset(const Dataset& d) {
     }
   };
   // Evaluation reads train frames from test cameras and test frames from
-  // train cameras, so every frame of either split needs every camera.
+  // train cameras, so every frame of either split needs every camera (but
+  // the images recorded missing).
   std::vector<std::string> all_cameras = d.train.cameras;
   all_cameras.insert(all_cameras.end(), d.test.cameras.begin(), d.test.cameras.end());
   for (const auto& id : d.train.frames) check_frame(id, all_cameras);
@@ -188,6 +245,11 @@ void write_dataset_manifest(const Dataset& d) {
   for (const auto& f : d.frames) {
     frames.push_back({{"id", f.id}, {"sequence", f.sequence}, {"head_to_world", pose_to_json(f.head_to_world)}});
   }
+  json missing_images = json::array();
+  for (const auto& m : d.missing_images)
+    missing_images.push_back({{"camera", m.camera}, {"frame", m.frame}, {"reason", m.reason}});
+  json dropped_frames = json::array();
+  for (const auto& f : d.dropped_frames) dropped_frames.push_back({{"frame", f.frame}, {"reason", f.reason}});
   const json manifest = {
       {"format", kFormat},
       {"version", kVersion},
@@ -201,6 +263,8 @@ void write_dataset_manifest(const Dataset& d) {
       {"split",
        {{"train", {{"frames", d.train.frames}, {"cameras", d.train.cameras}}},
         {"test", {{"frames", d.test.frames}, {"cameras", d.test.cameras}}}}},
+      {"missing_images", missing_images},
+      {"dropped_frames", dropped_frames},
   };
   write_text_atomic(d.root / kManifest, manifest.dump(1));
 }

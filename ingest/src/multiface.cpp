@@ -1,16 +1,16 @@
 #include "tega/ingest/multiface.h"
 
-#include <spdlog/spdlog.h>
-
 #include <algorithm>
 #include <set>
 
 #include "tega/core/dataset.h"
+#include "tega/core/dataset_gaps.h"
 #include "tega/core/downsample.h"
 #include "tega/core/error.h"
 #include "tega/core/files.h"
 #include "tega/core/image.h"
 #include "tega/core/image_header.h"
+#include "tega/core/log.h"
 #include "tega/core/progress.h"
 #include "tega/core/thread_pool.h"
 #include "tega/core/undistort.h"
@@ -35,7 +35,12 @@ void check_options(const IngestOptions& o) {
   if (o.matte != "mesh" && o.matte != "none") fail("matte must be 'mesh' or 'none', not '" + o.matte + "'");
   if (o.matte_dilation_px < 0 || o.matte_feather_px < 0) fail("matte_dilation_px and matte_feather_px must be >= 0");
   if (!o.face_forward.empty() && o.face_forward.size() != 3) fail("face_forward must be empty or 3 numbers");
+  check_missing_image_limits(o.missing_images, "ingest");
 }
+
+constexpr const char* kRemedy =
+    "restore the capture's images (a download cut short?), or leave out the cameras or expressions that lack them "
+    "(options cameras, expressions)";
 
 std::vector<MultifaceFrame> sample_uniformly(const std::vector<MultifaceFrame>& all, int count) {
   std::vector<MultifaceFrame> picked;
@@ -74,8 +79,8 @@ FramePlan plan_frames(const MultifaceCapture& capture, const IngestOptions& o) {
   for (const auto& s : sequences)
     if (has_prefix(s, o.test_expressions)) held_out.insert(s);
   if (held_out.empty()) {
-    spdlog::warn("{}: no expression matches test_expressions; holding out the last one, {}", list_file.string(),
-                 sequences.back());
+    logging::warn("%s: no expression matches test_expressions; holding out the last one, %s", list_file.c_str(),
+                  sequences.back().c_str());
     held_out.insert(sequences.back());
   }
   if (held_out.size() == sequences.size())
@@ -152,15 +157,28 @@ IngestSummary ingest_multiface(const fs::path& capture_root, const fs::path& out
   std::vector<std::string> used = cameras.train;
   used.insert(used.end(), cameras.test.begin(), cameras.test.end());
 
+  // Why each image (frame-major) cannot be used; empty when it can. A wrong
+  // size is an error rather than a gap: the options' width and height are
+  // more likely wrong than one image.
   ThreadPool pool(options.threads);
-  pool.parallel_for(0, static_cast<int64_t>(frames.size() * used.size()), [&](int64_t i) {
+  std::vector<std::string> unusable(frames.size() * used.size());
+  pool.parallel_for(0, static_cast<int64_t>(unusable.size()), [&](int64_t i) {
     const fs::path image = capture.image(used[i % used.size()], frames[i / used.size()]);
-    check_image_size(read_image_header(image), image, options);
+    if (!fs::exists(image)) {
+      unusable[i] = image.string() + ": is missing";
+      return;
+    }
+    ImageHeader header;
+    try {
+      header = read_image_header(image);
+    } catch (const Error& e) {
+      unusable[i] = e.what();
+      return;
+    }
+    check_image_size(header, image, options);
   });
 
-  StagedDirectory staged(out, replace_existing);
   Dataset dataset;
-  dataset.root = staged.path();
   dataset.template_mesh = template_mesh;
   const double scale = 1.0 / options.downsample;
   for (const Camera& camera : krt.cameras)
@@ -171,6 +189,19 @@ IngestSummary ingest_multiface(const fs::path& capture_root, const fs::path& out
   for (const auto& f : plan.test) dataset.test.frames.push_back(f.id());
   dataset.train.cameras = cameras.train;
   dataset.test.cameras = cameras.test;
+  for (size_t i = 0; i < unusable.size(); ++i) {
+    if (unusable[i].empty()) continue;
+    logging::warn("ingest multiface: leaving out %s", unusable[i].c_str());
+    dataset.missing_images.push_back({used[i % used.size()], frames[i / used.size()].id(), unusable[i]});
+  }
+  {
+    // Before the heavy work: a capture missing too much fails now.
+    Dataset planned = dataset;
+    apply_missing_image_limits(planned, options.missing_images, capture_root, kRemedy);
+  }
+
+  StagedDirectory staged(out, replace_existing);
+  dataset.root = staged.path();
 
   // Tracked meshes: millimetres in head space -> metres in world space.
   std::vector<Vertices> world(frames.size());
@@ -190,9 +221,22 @@ IngestSummary ingest_multiface(const fs::path& capture_root, const fs::path& out
     // Once per camera: the maps take as much memory as a float image.
     const UndistortionMaps maps = captured_camera.has_distortion() ? captured_camera.undistortion_maps()
                                                                    : UndistortionMaps{};
+    // Why each frame's image cannot be decoded (a truncated or corrupt file); empty when it can.
+    std::vector<std::string> undecodable(frames.size());
     pool.parallel_for(0, static_cast<int64_t>(frames.size()), [&](int64_t f) {
       const fs::path source = capture.image(output_camera.name, frames[f]);
-      const Image8 read = read_image_u8(source);
+      if (!dataset.has_image(output_camera.name, frames[f].id())) {
+        progress.advance();
+        return;
+      }
+      Image8 read;
+      try {
+        read = read_image_u8(source);
+      } catch (const Error& e) {
+        undecodable[f] = e.what();
+        progress.advance();
+        return;
+      }
       check_image_size({read.width, read.height, read.channels, 8}, source, options);
       const Image8 captured = rgb_of(read, source);
       const Image8 rgb = captured_camera.has_distortion() ? undistort_image(captured, maps, options.downsample)
@@ -213,18 +257,31 @@ IngestSummary ingest_multiface(const fs::path& capture_root, const fs::path& out
       write_image(rgba, dataset.image_path(output_camera.name, frames[f].id()));
       progress.advance();
     });
+    for (size_t f = 0; f < frames.size(); ++f) {
+      if (undecodable[f].empty()) continue;
+      logging::warn("ingest multiface: leaving out %s", undecodable[f].c_str());
+      dataset.missing_images.push_back({output_camera.name, frames[f].id(), undecodable[f]});
+    }
   }
   progress.finish();
 
+  apply_missing_image_limits(dataset, options.missing_images, capture_root, kRemedy);
+  for (const DroppedFrame& dropped : dataset.dropped_frames) {
+    logging::warn("ingest multiface: dropping frame %s: %s", dropped.frame.c_str(), dropped.reason.c_str());
+    remove_tree(dataset.mesh_path(dropped.frame));
+    for (const Camera& camera : dataset.rig.cameras) remove_tree(dataset.image_path(camera.name, dropped.frame));
+  }
   write_dataset_manifest(dataset);
   validate_dataset(read_dataset(staged.path()));
   staged.commit();
 
   IngestSummary summary;
   summary.dataset = staged.final_path();
-  summary.train_frames = static_cast<int>(plan.train.size());
-  summary.test_frames = static_cast<int>(plan.test.size());
-  summary.images = static_cast<int>(frames.size() * used.size());
+  summary.train_frames = static_cast<int>(dataset.train.frames.size());
+  summary.test_frames = static_cast<int>(dataset.test.frames.size());
+  summary.images = static_cast<int>(dataset.frames.size() * used.size() - dataset.missing_images.size());
+  summary.missing_images = static_cast<int>(dataset.missing_images.size());
+  summary.dropped_frames = static_cast<int>(dataset.dropped_frames.size());
   summary.train_cameras = cameras.train;
   summary.test_cameras = cameras.test;
   return summary;

@@ -1,8 +1,10 @@
 #include <iostream>
+#include <map>
 #include <memory>
 
 #include "commands.h"
 #include "tega/core/dataset.h"
+#include "tega/core/dataset_gaps.h"
 
 #ifdef TEGA_HAVE_MATTING
 #include "stage_options.h"
@@ -13,11 +15,30 @@ namespace tega::cli {
 
 namespace {
 
+// The images and frames the dataset's producer left out, counted per camera
+// and per frame, then each with its reason.
+void print_gaps(const Dataset& d) {
+  const std::string summary = dataset_gap_summary(d);
+  if (summary.empty()) return;
+  std::cout << "gaps (training and evaluation skip them): " << summary << "\n";
+  if (!d.missing_images.empty()) {
+    std::map<std::string, int> per_frame;
+    for (const auto& m : d.missing_images) ++per_frame[m.frame];
+    std::cout << "  missing images per frame:";
+    for (const auto& [frame, n] : per_frame) std::cout << " " << frame << ": " << n;
+    std::cout << "\n";
+    for (const auto& m : d.missing_images)
+      std::cout << "  missing image: camera " << m.camera << ", frame " << m.frame << ": " << m.reason << "\n";
+  }
+  for (const auto& f : d.dropped_frames) std::cout << "  dropped frame " << f.frame << ": " << f.reason << "\n";
+}
+
 void add_check_command(CLI::App& dataset) {
   auto* check = dataset.add_subcommand(
       "check", "Check a dataset the way training does before it starts: manifest, rig, template, split, "
                "every image (exists, size, RGBA) and every mesh (vertex count). Exits non-zero naming "
-               "the first offending file.");
+               "the first offending file. Reports the images and frames the dataset's producer left out "
+               "(missing_images, dropped_frames), per camera and per frame.");
   auto root = std::make_shared<std::string>();
   check->add_option("--data", *root, "Dataset directory (holds dataset.json).")->required();
   check->callback([root] {
@@ -28,6 +49,7 @@ void add_check_command(CLI::App& dataset) {
               << d.train.cameras.size() << " train, " << d.test.cameras.size() << " test), template "
               << d.template_mesh.num_vertices() << " vertices / " << d.template_mesh.num_faces()
               << " triangles\n";
+    print_gaps(d);
   });
 }
 
@@ -67,7 +89,11 @@ void add_build_command(CLI::App& dataset) {
     const auto s = matting::build_dataset(r, options);
     std::cout << s.dataset.string() << ": " << s.train_frames << " train + " << s.test_frames << " test frames, "
               << s.train_cameras.size() << " train + " << s.test_cameras.size() << " test cameras, " << s.images
-              << " images (" << s.images_kept << " kept from an interrupted run)\n";
+              << " images (" << s.images_kept << " kept from an interrupted run)";
+    if (s.missing_images > 0 || s.dropped_frames > 0)
+      std::cout << "; left out: " << s.missing_images << " missing or unreadable images, " << s.dropped_frames
+                << " frames with too few cameras (dataset.json: missing_images, dropped_frames)";
+    std::cout << "\n";
   });
 }
 #endif

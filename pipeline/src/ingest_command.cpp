@@ -88,7 +88,11 @@ void add_ingest_command(CLI::App& app) {
     const auto s = ingest::ingest_multiface(args->capture, args->out, options, args->force);
     std::cout << s.dataset.string() << ": " << s.train_frames << " train + " << s.test_frames << " test frames, "
               << s.images << " images; train cameras: " << joined(s.train_cameras)
-              << "; test cameras: " << joined(s.test_cameras) << "\n";
+              << "; test cameras: " << joined(s.test_cameras);
+    if (s.missing_images > 0 || s.dropped_frames > 0)
+      std::cout << "; left out: " << s.missing_images << " missing or unreadable images, " << s.dropped_frames
+                << " frames with too few cameras (dataset.json: missing_images, dropped_frames)";
+    std::cout << "\n";
   });
 }
 

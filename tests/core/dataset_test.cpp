@@ -55,6 +55,61 @@ TEST_F(DatasetTest, MissingImageIsNamed) {
       << validation_error();
 }
 
+TEST_F(DatasetTest, AMissingImageThatIsRecordedIsAcceptedAndRoundTrips) {
+  fs::remove(tmp / "images/cam01/smile_000000.png");
+  edit_manifest([](auto& m) {
+    m["missing_images"] = {{{"camera", "cam01"}, {"frame", "smile_000000"}, {"reason", "x.png: is missing"}}};
+    m["dropped_frames"] = {{{"frame", "smile_000003"}, {"reason", "usable images from 0 of 2 cameras"}}};
+  });
+  EXPECT_EQ(validation_error(), "");
+  tega::Dataset d = tega::read_dataset(tmp.path());
+  EXPECT_FALSE(d.has_image("cam01", "smile_000000"));
+  EXPECT_TRUE(d.has_image("cam00", "smile_000000"));
+  EXPECT_TRUE(d.has_image("cam01", "blink_000000"));
+
+  tega::write_dataset_manifest(d);
+  const tega::Dataset again = tega::read_dataset(tmp.path());
+  ASSERT_EQ(again.missing_images.size(), 1u);
+  EXPECT_EQ(again.missing_images[0].camera, "cam01");
+  EXPECT_EQ(again.missing_images[0].frame, "smile_000000");
+  EXPECT_EQ(again.missing_images[0].reason, "x.png: is missing");
+  ASSERT_EQ(again.dropped_frames.size(), 1u);
+  EXPECT_EQ(again.dropped_frames[0].frame, "smile_000003");
+  EXPECT_EQ(again.dropped_frames[0].reason, "usable images from 0 of 2 cameras");
+
+  // Another image missing, but not recorded: still an error naming it.
+  fs::remove(tmp / "images/cam00/blink_000000.png");
+  const std::string message = validation_error();
+  EXPECT_NE(message.find("images/cam00/blink_000000.png: is missing"), std::string::npos) << message;
+  EXPECT_NE(message.find("missing_images does not record it"), std::string::npos) << message;
+}
+
+TEST_F(DatasetTest, MalformedGapRecordsAreNamed) {
+  const auto read_error = [&] {
+    try {
+      tega::read_dataset(tmp.path());
+    } catch (const tega::Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  edit_manifest([](auto& m) { m["missing_images"] = {{{"camera", "cam01"}, {"frame", "frown_000001"}}}; });
+  EXPECT_NE(read_error().find("frame 'frown_000001') names an unknown frame"), std::string::npos) << read_error();
+  edit_manifest([](auto& m) { m["missing_images"] = {{{"camera", "cam09"}, {"frame", "smile_000000"}}}; });
+  EXPECT_NE(read_error().find("names a camera that is not in the rig"), std::string::npos) << read_error();
+  edit_manifest([](auto& m) {
+    m["missing_images"] = {{{"camera", "cam01"}, {"frame", "smile_000000"}}, {{"camera", "cam01"}, {"frame", "smile_000000"}}};
+  });
+  EXPECT_NE(read_error().find("is recorded twice"), std::string::npos) << read_error();
+  edit_manifest([](auto& m) { m["missing_images"] = "cam01"; });
+  EXPECT_NE(read_error().find("dataset.json: 'missing_images' must be a list"), std::string::npos) << read_error();
+  edit_manifest([](auto& m) {
+    m["missing_images"] = nlohmann::json::array();
+    m["dropped_frames"] = {{{"frame", "smile_000000"}}};
+  });
+  EXPECT_NE(read_error().find("frame 'smile_000000' is both kept and dropped"), std::string::npos) << read_error();
+}
+
 TEST_F(DatasetTest, ImageOfTheWrongSizeIsNamed) {
   tega::write_image(tega::Image8(9, 6, 4), tmp / "images/cam00/blink_000000.png");
   EXPECT_NE(validation_error().find("cam00/blink_000000.png: is 9x6"), std::string::npos) << validation_error();

@@ -268,6 +268,86 @@ TEST_F(MultifaceIngest, AnImageOfTheWrongSizeFailsNamingIt) {
   expect_failure_naming(capture, out(), small_options(), image);
 }
 
+TEST_F(MultifaceIngest, AMissingAndATruncatedImageAreLeftOutAndRecorded) {
+  const fs::path capture = copy_of_capture();
+  const ingest::MultifaceCapture layout{capture};
+  const auto& ring = fixture().ring;
+  // A train camera's image of a train frame deleted; a test camera's image
+  // of a test frame cut short: its PNG header still reads, its pixels do not.
+  const ingest::MultifaceFrame& train_frame = fixture().frames[2];
+  const ingest::MultifaceFrame& test_frame = fixture().frames[7];
+  const fs::path deleted = layout.image(ring[2], train_frame);
+  const fs::path truncated = layout.image(ring[3], test_frame);
+  fs::remove(deleted);
+  fs::resize_file(truncated, fs::file_size(truncated) / 2);
+
+  const auto summary = ingest::ingest_multiface(capture, out(), small_options());
+  const Dataset d = read_dataset(out());
+  validate_dataset(d);
+  ASSERT_EQ(d.missing_images.size(), 2u);
+  EXPECT_EQ(d.missing_images[0].camera, ring[2]);
+  EXPECT_EQ(d.missing_images[0].frame, train_frame.id());
+  EXPECT_NE(d.missing_images[0].reason.find(deleted.string() + ": is missing"), std::string::npos)
+      << d.missing_images[0].reason;
+  EXPECT_EQ(d.missing_images[1].camera, ring[3]);
+  EXPECT_EQ(d.missing_images[1].frame, test_frame.id());
+  EXPECT_NE(d.missing_images[1].reason.find(truncated.string()), std::string::npos) << d.missing_images[1].reason;
+  EXPECT_TRUE(d.dropped_frames.empty());
+  EXPECT_FALSE(fs::exists(d.image_path(ring[2], train_frame.id())));
+  EXPECT_FALSE(fs::exists(d.image_path(ring[3], test_frame.id())));
+  EXPECT_TRUE(fs::exists(d.image_path(ring[3], train_frame.id())));
+
+  // The rest is all there: every frame, every other image.
+  EXPECT_EQ(d.train.frames.size(), 4u);
+  EXPECT_EQ(d.test.frames.size(), 3u);
+  EXPECT_EQ(summary.missing_images, 2);
+  EXPECT_EQ(summary.images, 7 * 7 - 2);
+}
+
+TEST_F(MultifaceIngest, AFrameMostCamerasLackIsDroppedWhole) {
+  const fs::path capture = copy_of_capture();
+  const ingest::MultifaceCapture layout{capture};
+  const ingest::MultifaceFrame& frame = fixture().frames[0];  // a train frame
+  for (int c = 0; c < 4; ++c) fs::remove(layout.image(fixture().ring[c], frame));  // 3 of 7 cameras left
+
+  const auto summary = ingest::ingest_multiface(capture, out(), small_options());
+  const Dataset d = read_dataset(out());
+  validate_dataset(d);
+  ASSERT_EQ(d.dropped_frames.size(), 1u);
+  EXPECT_EQ(d.dropped_frames[0].frame, frame.id());
+  EXPECT_NE(d.dropped_frames[0].reason.find("usable images from 3 of 7 cameras"), std::string::npos)
+      << d.dropped_frames[0].reason;
+  EXPECT_TRUE(d.missing_images.empty());
+  EXPECT_EQ(d.train.frames.size(), 3u);
+  EXPECT_EQ(std::count(d.train.frames.begin(), d.train.frames.end(), frame.id()), 0);
+  EXPECT_FALSE(fs::exists(d.mesh_path(frame.id())));
+  EXPECT_FALSE(fs::exists(d.image_path(fixture().ring[5], frame.id())));
+  EXPECT_EQ(summary.dropped_frames, 1);
+}
+
+TEST_F(MultifaceIngest, ACaptureMissingTooMuchFailsSayingWhatAndLeavesNothing) {
+  const fs::path capture = copy_of_capture();
+  const ingest::MultifaceCapture layout{capture};
+  const std::string dead = fixture().ring[4];
+  for (const auto& frame : fixture().frames) fs::remove(layout.image(dead, frame));
+  const std::string message = test::error_message([&] { ingest::ingest_multiface(capture, out(), small_options()); });
+  EXPECT_NE(message.find(capture.string() + ": camera " + dead + " has no usable image of 7 of the 7 frames"),
+            std::string::npos)
+      << message;
+  EXPECT_NE(message.find("option"), std::string::npos) << message;  // what to do
+  EXPECT_NE(message.find("missing_images.max_missing_fraction_per_camera"), std::string::npos) << message;
+  EXPECT_FALSE(fs::exists(out()));
+  for (const auto& entry : fs::directory_iterator(out().parent_path()))
+    EXPECT_EQ(entry.path().filename().string().find("dataset"), std::string::npos) << entry.path();
+
+  // Leaving the camera out is what the message suggests, and it works.
+  ingest::IngestOptions without = small_options();
+  for (const auto& name : fixture().ring)
+    if (name != dead) without.cameras.push_back(name);
+  ingest::ingest_multiface(capture, out(), without);
+  EXPECT_TRUE(read_dataset(out()).missing_images.empty());
+}
+
 TEST_F(MultifaceIngest, AnExistingDatasetIsKeptUnlessReplacing) {
   fs::create_directories(out());
   test::write_text(out() / "keep.txt", "mine");

@@ -28,7 +28,8 @@ std::vector<SplitViews> evaluation_views(const Dataset& dataset, const std::stri
   const auto cross = [&](const std::string& name, const DatasetSplit& frames, const DatasetSplit& cameras) {
     SplitViews s{name, {}};
     for (const auto& f : frames.frames)
-      for (const auto& c : cameras.cameras) s.views.push_back({f, c});
+      for (const auto& c : cameras.cameras)
+        if (dataset.has_image(c, f)) s.views.push_back({f, c});  // the dataset's missing_images have no truth
     if (s.views.empty())
       throw Error(dataset.root / "dataset.json", "the " + name + " split has no view (no frame or no camera)");
     return s;

@@ -179,7 +179,8 @@ RenderSummary render_avatar(trainer::TrainedAvatar& avatar, const Dataset& datas
       ++summary.images;
 
       const fs::path truth = dataset.image_path(camera.name, frame.id);
-      if (job.side_by_side && rc.from_dataset && frame.from_dataset && fs::exists(truth)) {
+      if (job.side_by_side && rc.from_dataset && frame.from_dataset && dataset.has_image(camera.name, frame.id) &&
+          fs::exists(truth)) {
         at::Tensor target = trainer::composite_target(detail::read_rgba(truth).to(device), background);
         if (target.size(1) != camera.height || target.size(2) != camera.width) {
           const std::vector<int64_t> size{camera.height, camera.width};

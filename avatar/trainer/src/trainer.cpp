@@ -60,6 +60,7 @@ std::vector<View> views_of(const Dataset& d, const std::vector<std::string>& fra
     const auto names = d.rig.camera_names();
     const int c = static_cast<int>(std::find(names.begin(), names.end(), cam) - names.begin());
     for (const auto& id : frames) {
+      if (!d.has_image(cam, id)) continue;  // left out by the dataset's producer (missing_images)
       const int f = static_cast<int>(
           std::find_if(d.frames.begin(), d.frames.end(), [&](const DatasetFrame& x) { return x.id == id; }) -
           d.frames.begin());
@@ -131,6 +132,9 @@ class Run {
     logging::info("dataset %s: %zu frames, %zu cameras; %zu training views, template %d vertices; %lld Gaussians",
                   dataset_dir.c_str(), dataset_.frames.size(), dataset_.rig.cameras.size(), train_views_.size(),
                   dataset_.template_mesh.num_vertices(), static_cast<long long>(model_.gaussians.size()));
+    if (!dataset_.missing_images.empty())
+      logging::warn("dataset %s: %zu images are missing (dataset.json: missing_images); training skips them",
+                    dataset_dir.c_str(), dataset_.missing_images.size());
   }
 
   TrainSummary train(int64_t stop_at) {

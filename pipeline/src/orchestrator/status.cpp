@@ -5,6 +5,8 @@
 #include <optional>
 #include <sstream>
 
+#include "tega/core/dataset.h"
+#include "tega/core/dataset_gaps.h"
 #include "tega/core/error.h"
 #include "tega/core/progress.h"
 #include "tega/pipeline/manifest.h"
@@ -26,6 +28,16 @@ std::string change_between(const Fingerprint& then, const Fingerprint& now) {
     if (it->second != hash) return "its input " + name + " changed";
   }
   return "its inputs changed";
+}
+
+// What a committed dataset lacks. One that cannot be read has no report here:
+// the stage that reads it (dataset check, train) names what is wrong.
+std::string dataset_gaps(const fs::path& dataset) {
+  try {
+    return dataset_gap_summary(read_dataset(dataset));
+  } catch (const Error&) {
+    return "";
+  }
 }
 
 ShardStatus shard_status(const StageGraph& graph, size_t stage_index, size_t subject_index, const Workspace& ws,
@@ -101,6 +113,8 @@ ShardStatus shard_status(const StageGraph& graph, size_t stage_index, size_t sub
   }
   st.state = "done";
   output_hashes[{stage_index, subject_index}] = manifest->output_hash;
+  if (const auto dataset = stage.kind->provides.find("dataset"); dataset != stage.kind->provides.end())
+    st.dataset_gaps = dataset_gaps(ws.shard_dir(stage.name(), subject) / dataset->second);
   return st;
 }
 
@@ -150,6 +164,7 @@ std::string status_text(const WorkspaceStatus& status) {
       if (shard.state == "interrupted" || shard.state == "running") {
         out << "  log: " << shard.log;
       }
+      if (!shard.dataset_gaps.empty()) out << "  dataset gaps: " << shard.dataset_gaps;
       out << "\n";
     }
   }
@@ -172,7 +187,8 @@ std::string status_json(const WorkspaceStatus& status) {
                         {"reason", shard.reason},
                         {"log", shard.log},
                         {"finished", shard.finished},
-                        {"seconds", shard.seconds}});
+                        {"seconds", shard.seconds},
+                        {"dataset_gaps", shard.dataset_gaps}});
     }
     stages.push_back({{"stage", stage.name},
                       {"kind", stage.kind},

@@ -27,6 +27,22 @@ struct DatasetFrame {
   RigidTransform head_to_world;  // rigid head pose of this frame
 };
 
+// An image a producer left out: missing from the capture or unreadable. The
+// manifest records it (`missing_images`); training, evaluation and
+// validation skip it (docs/layouts.md#missing-images).
+struct MissingImage {
+  std::string camera;
+  std::string frame;   // a frame of Dataset::frames
+  std::string reason;  // what was wrong, naming the capture's file
+};
+
+// A sampled frame left out as a whole: too few of its cameras had a usable
+// image (`dropped_frames`). It is in no split and has no files.
+struct DroppedFrame {
+  std::string frame;
+  std::string reason;
+};
+
 struct DatasetSplit {
   std::vector<std::string> frames;
   std::vector<std::string> cameras;
@@ -41,22 +57,29 @@ struct Dataset {
   std::vector<DatasetFrame> frames;
   DatasetSplit train, test;  // test: held-out frames and held-out cameras
   std::string image_extension = ".png";  // or ".zst": raw pixels in zstd (image.h)
+  std::vector<MissingImage> missing_images;
+  std::vector<DroppedFrame> dropped_frames;
 
   std::filesystem::path mesh_path(const std::string& frame_id) const;
   std::filesystem::path image_path(const std::string& camera, const std::string& frame_id) const;
+  // False for an image recorded in missing_images: its file does not exist.
+  bool has_image(const std::string& camera, const std::string& frame_id) const;
   const DatasetFrame& frame(const std::string& frame_id) const;  // throws tega::Error
   Vertices load_mesh(const std::string& frame_id) const;          // checks the vertex count
 };
 
 // Reads dataset.json, the rig and the template. Throws tega::Error naming the
-// file for anything malformed or inconsistent in them.
+// file for anything malformed or inconsistent in them (a missing image of an
+// unknown frame or camera, or recorded twice; a dropped frame that is in
+// `frames`).
 Dataset read_dataset(const std::filesystem::path& root);
 
 // Checks everything training relies on before it starts: distortion-free
 // cameras (images are undistorted), every split frame
 // and camera exists, every image of a split frame x camera exists with the
-// camera's size and 4 channels, every mesh has the template's vertex count.
-// Throws tega::Error naming the first offending file.
+// camera's size and 4 channels unless missing_images records it, every mesh
+// has the template's vertex count. Throws tega::Error naming the first
+// offending file.
 void validate_dataset(const Dataset& dataset);
 
 // Writes dataset.json, rig.json and template.obj into dataset.root (each

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "tega/core/dataset_gaps.h"
+
 namespace tega::ingest {
 
 struct IngestOptions {
@@ -26,6 +28,7 @@ struct IngestOptions {
   double matte_dilation_px = 40.0;
   double matte_feather_px = 10.0;
   int downsample = 1;
+  MissingImageLimits missing_images;
   int threads = 0;
 
   template <class V>
@@ -64,6 +67,10 @@ struct IngestOptions {
     v("matte_feather_px", matte_feather_px,
       "Width of the soft edge beyond the dilation, in pixels of the capture's images (0 = hard edge).");
     v("downsample", downsample, "Image size divisor: 1 = full size (as the paper trains on Multiface), 2 = half.");
+    v("missing_images", missing_images,
+      "An image the capture lacks or that cannot be read (an interrupted download, a truncated file) is left out "
+      "with a warning and recorded in the dataset's missing_images; these limits drop frames that too few "
+      "cameras saw and stop the ingest when too much is missing (docs/multiface.md#missing-images).");
     v("threads", threads, "Worker threads; 0 = one per hardware thread.");
   }
 };

@@ -21,6 +21,9 @@ struct ShardStatus {
   std::string log;       // its log file, once it has run
   std::string finished;  // when the committed shard finished
   double seconds = 0;    // how long its command took
+  // A done shard that provides a dataset: the images and frames its producer
+  // left out (dataset_gap_summary); empty when there are none.
+  std::string dataset_gaps;
 };
 
 struct StageStatus {

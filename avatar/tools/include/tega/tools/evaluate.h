@@ -58,7 +58,8 @@ struct SplitViews {
   std::vector<EvalView> views;  // frame-major
 };
 // The views of a split: "test" gives reenactment and novel_view, "train" the
-// training views. Throws tega::Error for another name or an empty split.
+// training views; an image the dataset records as missing is no view.
+// Throws tega::Error for another name or an empty split.
 std::vector<SplitViews> evaluation_views(const Dataset& dataset, const std::string& split);
 
 // Renders and scores every view of `split`. lpips may be null (skipped).
