@@ -12,19 +12,16 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
-#include <optional>
 
 #include "tega/core/files.h"
 #include "tega/core/image.h"
 #include "tega/core/mesh.h"
 #include "tega/core/rig.h"
 #include "tega/core/take.h"
-#include "tega/core/undistort.h"
 #include "tega/matting/dataset_build.h"
 #include "tega/matting/dataset_image.h"
 #include "tega/matting/matte.h"
-#include "tega/mvs/debayer.h"
-#include "tega/mvs/frame_views.h"
+#include "tega/matting/recorded_image.h"
 #include "tega/synth/virtual_studio.h"
 #include "tega/tracking/evaluation.h"
 #include "tega/tracking/tracked.h"
@@ -73,12 +70,6 @@ void storage_table(const Image8& rgba, const fs::path& dir, int repeats) {
   }
 }
 
-// A captured image as the stages see it: RGB, debayered where it is raw.
-Image8 read_photo(const TakeInfo& take, const std::string& camera, int frame) {
-  const fs::path file = take.image_path(camera, frame);
-  return mvs::recorded_rgb(read_image_u8(file), take, mvs::debayer, file.string());
-}
-
 // Every take of the capture stored as raw BayerRG8 (R G / G B), the way
 // tega capture writes a studio camera's frames (PNG level 1).
 void mosaic_capture(const fs::path& capture) {
@@ -104,24 +95,19 @@ void mosaic_capture(const fs::path& capture) {
 // One image's steps, one thread: where the time of a build goes.
 void stage_table(const fs::path& capture, const Camera& camera, int downsample) {
   const TakeInfo take = read_take(capture / "takes" / "expressions");
-  Image8 rgb, matte, rgba, undistorted, small;
-  const double read_s = timed(1, [&] { rgb = read_photo(take, camera.name, 0); });
-  const double matte_s =
-      timed(1, [&] { matte = read_image_u8(capture / "ground_truth" / "expressions" / "alpha" / camera.name / "000000.png"); });
-  rgba = Image8(rgb.width, rgb.height, 4);
-  for (size_t i = 0; i < matte.pixels.size(); ++i) {
-    for (int c = 0; c < 3; ++c) rgba.pixels[4 * i + c] = rgb.pixels[3 * i + c];
-    rgba.pixels[4 * i + 3] = matte.pixels[i];
-  }
-  const UndistortionMaps maps = camera.undistortion_maps();
-  const double core_s = timed(1, [&] { small = undistort_image(rgba, maps, downsample); });
-  std::optional<matting::DatasetResampler> resampler;
-  resampler.emplace(camera, downsample);
-  const double resampler_s = timed(3, [&] { small = resampler->rgba(rgb, matte); });
-  std::printf("\none image, one thread (s): read the %dx%d capture as RGB %.2f, read its matte %.2f; RGB + matte to "
-              "the dataset's RGBA with OpenCV (what the build does) %.2f, core's undistort_image of the RGBA %.2f; "
-              "writing: below\n",
-              rgb.width, rgb.height, read_s, matte_s, resampler_s, core_s);
+  Image8 rgb, matte, small;
+  const double read_s = timed(1, [&] {
+    rgb = matting::read_recorded_rgb(take, camera.name, 0, camera.width, camera.height, downsample);
+  });
+  const double matte_s = timed(1, [&] {
+    matte = matting::area_downsampled(
+        read_image_u8(capture / "ground_truth" / "expressions" / "alpha" / camera.name / "000000.png"), downsample);
+  });
+  const matting::DatasetResampler resampler(camera, downsample);
+  const double resampler_s = timed(3, [&] { small = resampler.rgba(rgb, matte); });
+  std::printf("\none image, one thread (s): read the %dx%d capture at the dataset's %dx%d %.2f, read its matte and "
+              "shrink it %.2f; RGB + matte undistorted into the dataset's RGBA %.2f; writing: below\n",
+              camera.width, camera.height, rgb.width, rgb.height, read_s, matte_s, resampler_s);
 }
 
 // One image's matte, one thread: where the time of tega matte goes.
@@ -132,9 +118,9 @@ void matte_table(const fs::path& capture, const fs::path& tracked, const Camera&
   const tracking::TrackedFrame frame = tracking::read_tracked_take(tracked, "expressions").front();
   Image8 photo, alpha;
   Vertices world;
-  const double read_s = timed(1, [&] { photo = read_photo(take, camera.name, frame.frame); });
+  const double read_s = timed(1, [&] { photo = matting::read_recorded_rgb(take, camera.name, frame.frame, camera.width, camera.height); });
   const double mesh_s = timed(1, [&] { world = read_vertices_bin(frame.mesh, subject.neutral.num_vertices()); });
-  const matting::CameraMatting matting(camera, read_photo(plate_take, camera.name, 0), matting::MatteOptions());
+  const matting::CameraMatting matting(camera, matting::read_recorded_rgb(plate_take, camera.name, 0, camera.width, camera.height), matting::MatteOptions());
   const double matte_s = timed(3, [&] { alpha = matting.matte(photo, world, subject.neutral.faces); });
   const fs::path file = fs::temp_directory_path() / "tega-bench-matte.png";
   const double write_s = timed(3, [&] { matting::write_matte(alpha, file); });
@@ -202,12 +188,20 @@ int main(int argc, char** argv) {
   // resampler's maps, and for matting the clean plate, read and shrunk.
   const Camera& first_camera = rig.cameras.front();
   const double resampler_s = timed(1, [&] { matting::DatasetResampler(first_camera, downsample); });
-  const double plate_s = timed(1, [&] {
-    matting::CameraMatting(first_camera, read_photo(read_take(capture / "takes" / "clean_plate"), first_camera.name, 0),
-                           matting::MatteOptions());
-  });
-  std::printf("once per camera (s): the resampler's maps %.2f, the clean plate read and shrunk %.2f\n", resampler_s,
-              plate_s);
+  // tega matte mattes the full-size photos, the build at the dataset's size.
+  const TakeInfo plate_take = read_take(capture / "takes" / "clean_plate");
+  const auto plate_cost = [&](int size_factor) {
+    return timed(1, [&] {
+      matting::CameraMatting(matting::recorded_camera_at_dataset_size(first_camera, size_factor),
+                             matting::read_recorded_rgb(plate_take, first_camera.name, 0, first_camera.width,
+                                                        first_camera.height, size_factor),
+                             matting::MatteOptions());
+    });
+  };
+  const double plate_s = plate_cost(1), small_plate_s = plate_cost(downsample);
+  std::printf("once per camera (s): the resampler's maps %.2f, the clean plate read and shrunk %.2f (tega matte), "
+              "%.2f (the build)\n",
+              resampler_s, plate_s, small_plate_s);
 
   std::printf("\n%-46s %8s %10s %10s %14s %16s\n", "run (2 threads)", "images", "seconds", "images/s",
               "images/s steady", "CPU s per image");
@@ -246,7 +240,7 @@ int main(int argc, char** argv) {
     const auto one_pass = matting::build_dataset(
         {capture, tracked, {}, work / ("dataset-matted-here" + std::to_string(level)), {}, true}, options);
     report("tega dataset build, matting here" + suffix, one_pass.images, seconds_since(start),
-           cpu_seconds() - cpu_start, plate_s + resampler_s);
+           cpu_seconds() - cpu_start, small_plate_s + resampler_s);
     uintmax_t bytes = 0;
     for (const auto& entry : fs::recursive_directory_iterator(one_pass.dataset / "images"))
       if (entry.is_regular_file()) bytes += entry.file_size();
@@ -264,7 +258,7 @@ int main(int argc, char** argv) {
     cpu_start = cpu_seconds();
     const auto zst = matting::build_dataset({capture, tracked, {}, work / "dataset-matted-here-zst", {}, true}, options);
     report("tega dataset build, matting here (zst)", zst.images, seconds_since(start), cpu_seconds() - cpu_start,
-           plate_s + resampler_s);
+           small_plate_s + resampler_s);
   }
 
   matte_table(capture, tracked, first_camera);

@@ -6,8 +6,8 @@
 
 #include "clean_plate.h"
 #include "opencv_threads.h"
-#include "recorded_image.h"
 #include "tega/core/dataset.h"
+#include "tega/core/dataset_gaps.h"
 #include "tega/core/error.h"
 #include "tega/core/files.h"
 #include "tega/core/image_header.h"
@@ -20,6 +20,7 @@
 #include "tega/core/undistort.h"
 #include "tega/matting/dataset_image.h"
 #include "tega/matting/matte.h"
+#include "tega/matting/recorded_image.h"
 #include "tega/tracking/tracked.h"
 
 namespace tega::matting {
@@ -37,7 +38,12 @@ void check_options(const DatasetBuildOptions& o) {
   if (o.png_compression < 0 || o.png_compression > 9) fail("png_compression must be in 0 .. 9");
   if (o.image_format != "png" && o.image_format != "zst")
     fail("image_format must be png or zst, not '" + o.image_format + "'");
+  check_missing_image_limits(o.missing_images, "dataset build");
 }
+
+constexpr const char* kRemedy =
+    "repair or recover the take's images (a camera that stopped recording, a disk that filled), or build from "
+    "takes or frames that have them (options frames, test_takes)";
 
 bool contains(const std::vector<std::string>& names, const std::string& name) {
   return std::find(names.begin(), names.end(), name) != names.end();
@@ -49,7 +55,7 @@ std::string frame_name(int frame) {
   return name;
 }
 
-// A tracked frame the dataset may take: every camera recorded it.
+// A tracked frame the dataset may take: enough cameras recorded it.
 struct Candidate {
   const TakeInfo* take;
   tracking::TrackedFrame tracked;
@@ -139,17 +145,22 @@ Inputs read_inputs(const DatasetBuildRequest& request, const DatasetBuildOptions
       if (frame.frame < 0 || frame.frame >= take.frames)
         throw Error(frame.mesh, "is tracked frame " + std::to_string(frame.frame) + " of take " + name + ", which has " +
                                     std::to_string(take.frames) + " frames");
-      const bool recorded = std::all_of(in.rig.cameras.begin(), in.rig.cameras.end(),
-                                        [&](const Camera& c) { return take.has_image(c.name, frame.frame); });
-      if (recorded) in.candidates.push_back({&take, std::move(frame)});
-      else ++incomplete;
+      const auto recorded = std::count_if(in.rig.cameras.begin(), in.rig.cameras.end(),
+                                          [&](const Camera& c) { return take.has_image(c.name, frame.frame); });
+      if (recorded > 0 && static_cast<double>(recorded) >=
+                              options.missing_images.min_camera_fraction_per_frame * in.rig.cameras.size())
+        in.candidates.push_back({&take, std::move(frame)});
+      else
+        ++incomplete;
     }
   }
   if (incomplete > 0)
-    logging::warn("dataset build: %d tracked frame(s) left out: a camera has no image of them (take.json: missing)",
+    logging::warn("dataset build: %d tracked frame(s) left out before sampling: too few cameras recorded them "
+                  "(take.json: missing; missing_images.min_camera_fraction_per_frame)",
                   incomplete);
   if (in.candidates.empty())
-    throw Error(request.tracked, "has no tracked frame that every camera recorded: nothing to build a dataset from");
+    throw Error(request.tracked, "has no tracked frame that enough cameras recorded (take.json: missing; "
+                                 "missing_images.min_camera_fraction_per_frame): nothing to build a dataset from");
   return in;
 }
 
@@ -177,21 +188,31 @@ void choose_cameras(Dataset& dataset, const Inputs& in, const DatasetBuildOption
 }
 
 // Everything that can be checked cheaply, before the heavy work: each image
-// and matte exists (`mattes` empty: none is read), and the mattes have the
-// captured size.
-void check_views(const std::vector<const Candidate*>& frames, const Inputs& in, const fs::path& mattes,
-                 ThreadPool& pool) {
+// exists (returned: why each, frame-major, cannot be used; empty when it
+// can), and so does the matte of each that does (`mattes` empty: none is
+// read), with the captured size.
+std::vector<std::string> check_views(const std::vector<const Candidate*>& frames, const Inputs& in,
+                                     const fs::path& mattes, ThreadPool& pool) {
   const size_t n = in.rig.cameras.size();
+  std::vector<std::string> unusable(frames.size() * n);
   pool.parallel_for(0, static_cast<int64_t>(frames.size() * n), [&](int64_t i) {
     const Candidate& f = *frames[static_cast<size_t>(i) / n];
     const Camera& camera = in.rig.cameras[static_cast<size_t>(i) % n];
     const fs::path image = f.take->image_path(camera.name, f.tracked.frame);
-    if (!fs::exists(image)) throw Error(image, "is missing (" + view_name(f, camera.name) + ")");
+    if (!f.take->has_image(camera.name, f.tracked.frame)) {
+      unusable[i] = image.string() + ": was not recorded (take.json: missing)";
+      return;
+    }
+    if (!fs::exists(image)) {
+      unusable[i] = image.string() + ": is missing (" + view_name(f, camera.name) + ")";
+      return;
+    }
     if (mattes.empty()) return;
     const fs::path matte = matte_path(mattes, f, camera.name);
     if (!fs::exists(matte)) throw Error(matte, "is missing (the matte of " + view_name(f, camera.name) + "; run tega matte)");
     check_matte(matte, read_image_header(matte), camera.width, camera.height);
   });
+  return unusable;
 }
 
 }  // namespace
@@ -206,7 +227,7 @@ DatasetBuildSummary build_dataset(const DatasetBuildRequest& request, const Data
     frames.push_back(&in.candidates[i]);
 
   ThreadPool pool(options.threads);
-  check_views(frames, in, request.mattes, pool);
+  const std::vector<std::string> unusable = check_views(frames, in, request.mattes, pool);
 
   Dataset dataset;
   dataset.image_extension = "." + options.image_format;
@@ -219,6 +240,17 @@ DatasetBuildSummary build_dataset(const DatasetBuildRequest& request, const Data
   for (const Candidate* f : frames) {
     dataset.frames.push_back({f->id(), f->take->name, f->tracked.head_to_world});
     (contains(test_takes, f->take->name) ? dataset.test : dataset.train).frames.push_back(f->id());
+  }
+  const size_t n = in.rig.cameras.size();
+  for (size_t i = 0; i < unusable.size(); ++i) {
+    if (unusable[i].empty()) continue;
+    logging::warn("dataset build: leaving out %s", unusable[i].c_str());
+    dataset.missing_images.push_back({in.rig.cameras[i % n].name, frames[i / n]->id(), unusable[i]});
+  }
+  {
+    // Before the heavy work: a capture missing too much fails now.
+    Dataset planned = dataset;
+    apply_missing_image_limits(planned, options.missing_images, request.capture, kRemedy);
   }
 
   DatasetBuildOptions resume_options = options;
@@ -244,7 +276,9 @@ DatasetBuildSummary build_dataset(const DatasetBuildRequest& request, const Data
     fs::create_directories(dataset.image_path(camera, "x").parent_path());
     std::vector<const Candidate*> to_write;
     for (const Candidate* f : frames) {
-      if (fs::exists(dataset.image_path(camera, f->id()))) {
+      if (!dataset.has_image(camera, f->id())) {
+        progress.advance();
+      } else if (fs::exists(dataset.image_path(camera, f->id()))) {
         ++kept;
         progress.advance();
       } else {
@@ -254,28 +288,52 @@ DatasetBuildSummary build_dataset(const DatasetBuildRequest& request, const Data
     if (to_write.empty()) continue;
     // Once per camera: at 6144 x 4096 the maps take a second to make.
     const DatasetResampler resampler(captured, options.downsample);
+    // Everything happens at the dataset's size: the full-size photo is never made.
+    const int downsample = options.downsample;
     std::optional<CameraMatting> matting;
     if (request.mattes.empty())
-      matting.emplace(captured,
-                      in.clean_plate ? read_recorded_rgb(*in.clean_plate, camera, 0, captured.width, captured.height)
+      matting.emplace(recorded_camera_at_dataset_size(captured, downsample),
+                      in.clean_plate ? read_recorded_rgb(*in.clean_plate, camera, 0, captured.width, captured.height,
+                                                         downsample)
                                      : Image8(),
                       options.matte);
+    // Why each image cannot be used (undecodable, the wrong size); empty when it can.
+    std::vector<std::string> unreadable(to_write.size());
     pool.parallel_for(0, static_cast<int64_t>(to_write.size()), [&](int64_t i) {
       const Candidate& f = *to_write[static_cast<size_t>(i)];
-      const Image8 rgb = read_recorded_rgb(*f.take, camera, f.tracked.frame, captured.width, captured.height);
+      Image8 rgb;
+      try {
+        rgb = read_recorded_rgb(*f.take, camera, f.tracked.frame, captured.width, captured.height, downsample);
+      } catch (const Error& e) {
+        unreadable[static_cast<size_t>(i)] = e.what();
+        progress.advance();
+        return;
+      }
       const Image8 matte =
           matting ? matting->matte(rgb, read_vertices_bin(f.tracked.mesh, vertices), dataset.template_mesh.faces)
-                  : read_matte(matte_path(request.mattes, f, camera), captured.width, captured.height,
-                               view_name(f, camera));
+                  : area_downsampled(read_matte(matte_path(request.mattes, f, camera), captured.width,
+                                                captured.height, view_name(f, camera)),
+                                     downsample);
       const Image8 rgba = resampler.rgba(rgb, matte);
       const PixelView view{rgba.pixels.data(), rgba.width, rgba.height, 4, 8, static_cast<size_t>(rgba.width) * 4};
       if (options.image_format == "zst") write_zstd_view(view, dataset.image_path(camera, f.id()), 1);
       else write_png_view(view, dataset.image_path(camera, f.id()), options.png_compression);
       progress.advance();
     });
+    for (size_t i = 0; i < to_write.size(); ++i) {
+      if (unreadable[i].empty()) continue;
+      logging::warn("dataset build: leaving out %s", unreadable[i].c_str());
+      dataset.missing_images.push_back({camera, to_write[i]->id(), unreadable[i]});
+    }
   }
   progress.finish();
 
+  apply_missing_image_limits(dataset, options.missing_images, request.capture, kRemedy);
+  for (const DroppedFrame& dropped : dataset.dropped_frames) {
+    logging::warn("dataset build: dropping frame %s: %s", dropped.frame.c_str(), dropped.reason.c_str());
+    remove_tree(dataset.mesh_path(dropped.frame));
+    for (const Camera& camera : dataset.rig.cameras) remove_tree(dataset.image_path(camera.name, dropped.frame));
+  }
   write_dataset_manifest(dataset);
   validate_dataset(read_dataset(staged.path()));
   staged.commit();
@@ -286,8 +344,10 @@ DatasetBuildSummary build_dataset(const DatasetBuildRequest& request, const Data
   summary.test_frames = static_cast<int>(dataset.test.frames.size());
   summary.train_cameras = dataset.train.cameras;
   summary.test_cameras = dataset.test.cameras;
-  summary.images = static_cast<int>(total);
+  summary.images = static_cast<int>(dataset.frames.size() * n - dataset.missing_images.size());
   summary.images_kept = kept;
+  summary.missing_images = static_cast<int>(dataset.missing_images.size());
+  summary.dropped_frames = static_cast<int>(dataset.dropped_frames.size());
   return summary;
 }
 

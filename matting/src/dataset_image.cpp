@@ -31,19 +31,21 @@ cv::Mat view_of(const Image8& image) {
   return cv::Mat(image.height, image.width, CV_8UC(image.channels), const_cast<uint8_t*>(image.pixels.data()));
 }
 
-// Output rows resampled at a time: the strip of full-size rows behind them
-// (3 + 1 channels) stays within a few megabytes.
-constexpr int kStripRows = 32;
-
 }  // namespace
 
-DatasetResampler::DatasetResampler(const Camera& captured, int downsample)
-    : width_(captured.width), height_(captured.height), downsample_(downsample) {
-  if (downsample < 1 || width_ % downsample != 0 || height_ % downsample != 0)
+Camera recorded_camera_at_dataset_size(const Camera& captured, int downsample) {
+  if (downsample < 1 || captured.width % downsample != 0 || captured.height % downsample != 0)
     throw Error("downsample " + std::to_string(downsample) + " does not divide camera " + captured.name + "'s size " +
-                std::to_string(width_) + "x" + std::to_string(height_));
-  if (!captured.has_distortion()) return;
-  UndistortionMaps maps = captured.undistortion_maps();
+                std::to_string(captured.width) + "x" + std::to_string(captured.height));
+  return captured.scaled(1.0 / downsample);
+}
+
+DatasetResampler::DatasetResampler(const Camera& captured, int downsample) {
+  const Camera camera = recorded_camera_at_dataset_size(captured, downsample);
+  width_ = camera.width;
+  height_ = camera.height;
+  if (!camera.has_distortion()) return;
+  UndistortionMaps maps = camera.undistortion_maps();
   // core's rule (undistort.h): the captured image covers [-0.5, w - 0.5];
   // inside, positions clamp to the outermost pixel centres; outside, black.
   // A position moved well off the image gives OpenCV's constant border.
@@ -67,36 +69,16 @@ Image8 DatasetResampler::rgba(const Image8& rgb, const Image8& matte) const {
       matte.height != height_ || matte.channels != 1)
     throw Error("dataset image: the photo (" + std::to_string(rgb.width) + "x" + std::to_string(rgb.height) +
                 ") and its matte (" + std::to_string(matte.width) + "x" + std::to_string(matte.height) +
-                ") must both have the camera's size " + std::to_string(width_) + "x" + std::to_string(height_));
-  const cv::Mat colour = view_of(rgb), alpha = view_of(matte);
-  Image8 out(width_ / downsample_, height_ / downsample_, 4);
-  const cv::Mat result = view_of(out);
-  const int strip = kStripRows * downsample_;
-  cv::Mat colour_strip, alpha_strip, small_colour, small_alpha;
-  for (int y = 0; y < height_; y += strip) {
-    const cv::Range rows(y, std::min(height_, y + strip));
-    if (map_xy_.empty()) {
-      colour_strip = colour.rowRange(rows);
-      alpha_strip = alpha.rowRange(rows);
-    } else {
-      cv::remap(colour, colour_strip, map_xy_.rowRange(rows), map_fraction_.rowRange(rows), cv::INTER_LINEAR,
-                cv::BORDER_CONSTANT);
-      cv::remap(alpha, alpha_strip, map_xy_.rowRange(rows), map_fraction_.rowRange(rows), cv::INTER_LINEAR,
-                cv::BORDER_CONSTANT);
-    }
-    const cv::Size small(width_ / downsample_, rows.size() / downsample_);
-    if (downsample_ > 1) {
-      cv::resize(colour_strip, small_colour, small, 0, 0, cv::INTER_AREA);
-      cv::resize(alpha_strip, small_alpha, small, 0, 0, cv::INTER_AREA);
-    } else {
-      small_colour = colour_strip;
-      small_alpha = alpha_strip;
-    }
-    const cv::Mat sources[] = {small_colour, small_alpha};
-    cv::Mat target = result.rowRange(rows.start / downsample_, rows.end / downsample_);
-    const int from_to[] = {0, 0, 1, 1, 2, 2, 3, 3};
-    cv::mixChannels(sources, 2, &target, 1, from_to, 4);
-  }
+                ") must both have the dataset's size " + std::to_string(width_) + "x" + std::to_string(height_));
+  Image8 recorded(width_, height_, 4);
+  cv::Mat interleaved = view_of(recorded);
+  const cv::Mat sources[] = {view_of(rgb), view_of(matte)};
+  const int from_to[] = {0, 0, 1, 1, 2, 2, 3, 3};
+  cv::mixChannels(sources, 2, &interleaved, 1, from_to, 4);
+  if (map_xy_.empty()) return recorded;
+  Image8 out(width_, height_, 4);
+  cv::Mat target = view_of(out);
+  cv::remap(interleaved, target, map_xy_, map_fraction_, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
   return out;
 }
 

@@ -8,7 +8,6 @@
 
 #include "clean_plate.h"
 #include "opencv_threads.h"
-#include "recorded_image.h"
 #include "tega/core/error.h"
 #include "tega/core/files.h"
 #include "tega/core/options.h"
@@ -17,6 +16,7 @@
 #include "tega/core/take.h"
 #include "tega/core/thread_pool.h"
 #include "tega/matting/matte.h"
+#include "tega/matting/recorded_image.h"
 #include "tega/tracking/tracked.h"
 
 namespace tega::matting {

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "tega/core/dataset_gaps.h"
 #include "tega/matting/matte_options.h"
 
 namespace tega::matting {
@@ -24,6 +25,7 @@ struct DatasetBuildOptions {
   int png_compression = 1;
   int threads = 0;
   MatteOptions matte;  // without a MATTES folder; its `threads` is not used
+  MissingImageLimits missing_images;
 
   template <class V>
   void visit(V& v) {
@@ -52,6 +54,11 @@ struct DatasetBuildOptions {
       "How the images are matted when no folder of tega matte's mattes is given (the same method and options as "
       "tega matte; matte.threads is not used): each sampled image is matted as it is built, its photo decoded "
       "once.");
+    v("missing_images", missing_images,
+      "A recorded image that is missing, unreadable or not its camera's size (a camera that dropped frames, "
+      "take.json's `missing`, a disk error) is left out with a warning and recorded in the dataset's "
+      "missing_images; these limits drop frames that too few cameras saw and stop the build when too much is "
+      "missing (docs/matting.md#missing-images).");
   }
 };
 
@@ -72,11 +79,14 @@ struct DatasetBuildSummary {
   std::vector<std::string> train_cameras, test_cameras;
   int images = 0;       // in the dataset
   int images_kept = 0;  // of them, written by an interrupted run with the same options and inputs
+  int missing_images = 0, dropped_frames = 0;  // recorded in the manifest (docs/matting.md#missing-images)
 };
 
 // Throws tega::Error naming the file for bad input: a missing or damaged
-// capture, rig, tracked take, mesh, image or matte; a matte or image whose size
-// is not the camera's; options the capture cannot satisfy. An interrupted run
+// capture, rig, tracked take, mesh or matte; a matte whose size is not the
+// camera's; options the capture cannot satisfy. A recorded image that is
+// missing or unreadable is left out and recorded, within
+// options.missing_images' limits. An interrupted run
 // leaves DATASET.partial/, which a run with the same options and inputs
 // continues.
 DatasetBuildSummary build_dataset(const DatasetBuildRequest& request, const DatasetBuildOptions& options);

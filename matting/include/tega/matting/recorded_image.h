@@ -9,8 +9,14 @@
 
 namespace tega::matting {
 
-// Throws tega::Error naming the file when it is missing, unreadable, not
-// width x height, or does not fit the take's pixel format.
-Image8 read_recorded_rgb(const TakeInfo& take, const std::string& camera, int frame, int width, int height);
+// The image at 1/downsample of the camera's size (area-averaged; a raw Bayer
+// mosaic is demosaiced straight to half size, so that the full-size RGB is
+// never made). Throws tega::Error naming the file when it is missing,
+// unreadable, not width x height, or does not fit the take's pixel format.
+Image8 read_recorded_rgb(const TakeInfo& take, const std::string& camera, int frame, int width, int height,
+                         int downsample = 1);
+
+// `image` shrunk by `factor` by averaging factor x factor blocks.
+Image8 area_downsampled(const Image8& image, int factor);
 
 }  // namespace tega::matting
