@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <new>
 #include <vector>
 
 #include "image_backends.h"
@@ -48,15 +49,26 @@ ImageHeader parse_header(const unsigned char* head, size_t bytes, const fs::path
 
 template <typename T>
 StoredImage decode(const ImageHeader& h, const std::vector<char>& file_bytes, const fs::path& file) {
-  ImageBuffer<T> image(h.width, h.height, h.channels);
-  const size_t expected = image.pixels.size() * sizeof(T);
+  const size_t expected = size_t(h.width) * size_t(h.height) * size_t(h.channels) * sizeof(T);
   const char* frame = file_bytes.data() + kHeaderBytes;
   const size_t frame_bytes = file_bytes.size() - kHeaderBytes;
+  // Checked before allocating: a damaged header may promise gigabytes.
+  // zstd expands a frame at most 32768-fold (a 4-byte RLE block holds 128 KiB).
+  constexpr size_t kMaxZstdExpansion = 32768;
+  if (expected / kMaxZstdExpansion > frame_bytes)
+    throw Error(file, "is truncated: " + std::to_string(frame_bytes) + " bytes of zstd cannot hold the " +
+                          std::to_string(expected) + " its header promises");
   const unsigned long long content = ZSTD_getFrameContentSize(frame, frame_bytes);
   if (content != expected)
     throw Error(file, "holds " + (content == ZSTD_CONTENTSIZE_ERROR ? std::string("no valid zstd frame")
                                                                      : std::to_string(content) + " bytes") +
                           " where its header promises " + std::to_string(expected));
+  ImageBuffer<T> image;
+  try {
+    image = ImageBuffer<T>(h.width, h.height, h.channels);
+  } catch (const std::bad_alloc&) {
+    throw Error(file, "needs " + std::to_string(expected) + " bytes to decode, more memory than there is");
+  }
   const size_t got = ZSTD_decompress(image.pixels.data(), expected, frame, frame_bytes);
   if (ZSTD_isError(got) || got != expected)
     throw Error(file, std::string("is damaged (zstd: ") + (ZSTD_isError(got) ? ZSTD_getErrorName(got) : "short") + ")");

@@ -25,7 +25,8 @@ Vertices read_vertices_bin(const std::filesystem::path& file, int expected_verti
     throw Error(file, "expected " + std::to_string(expected_vertices) + " vertices, found " + std::to_string(count));
   }
   Vertices vertices(count, 3);
-  std::memcpy(vertices.data(), bytes.data(), bytes.size());
+  // An empty file is an empty mesh, whose data() is null: memcpy may not see it.
+  if (count > 0) std::memcpy(vertices.data(), bytes.data(), bytes.size());
   return vertices;
 }
 
