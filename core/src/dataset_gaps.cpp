@@ -6,6 +6,8 @@
 #include <sstream>
 
 #include "tega/core/error.h"
+#include "tega/core/files.h"
+#include "tega/core/log.h"
 
 namespace tega {
 
@@ -112,6 +114,17 @@ void apply_missing_image_limits(Dataset& dataset, const MissingImageLimits& limi
   check_dropped(dataset, train, "train", limits, source, remedy);
   check_dropped(dataset, test, "test", limits, source, remedy);
   check_cameras(dataset, limits, source, remedy);
+}
+
+void drop_frames_lacking_images(Dataset& dataset, const MissingImageLimits& limits,
+                                const std::filesystem::path& source, const std::string& remedy,
+                                const std::string& stage) {
+  apply_missing_image_limits(dataset, limits, source, remedy);
+  for (const DroppedFrame& dropped : dataset.dropped_frames) {
+    logging::warn("%s: dropping frame %s: %s", stage.c_str(), dropped.frame.c_str(), dropped.reason.c_str());
+    remove_tree(dataset.mesh_path(dropped.frame));
+    for (const Camera& camera : dataset.rig.cameras) remove_tree(dataset.image_path(camera.name, dropped.frame));
+  }
 }
 
 std::string dataset_gap_summary(const Dataset& dataset) {

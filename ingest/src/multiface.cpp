@@ -265,12 +265,7 @@ IngestSummary ingest_multiface(const fs::path& capture_root, const fs::path& out
   }
   progress.finish();
 
-  apply_missing_image_limits(dataset, options.missing_images, capture_root, kRemedy);
-  for (const DroppedFrame& dropped : dataset.dropped_frames) {
-    logging::warn("ingest multiface: dropping frame %s: %s", dropped.frame.c_str(), dropped.reason.c_str());
-    remove_tree(dataset.mesh_path(dropped.frame));
-    for (const Camera& camera : dataset.rig.cameras) remove_tree(dataset.image_path(camera.name, dropped.frame));
-  }
+  drop_frames_lacking_images(dataset, options.missing_images, capture_root, kRemedy, "ingest multiface");
   write_dataset_manifest(dataset);
   validate_dataset(read_dataset(staged.path()));
   staged.commit();

@@ -328,12 +328,7 @@ DatasetBuildSummary build_dataset(const DatasetBuildRequest& request, const Data
   }
   progress.finish();
 
-  apply_missing_image_limits(dataset, options.missing_images, request.capture, kRemedy);
-  for (const DroppedFrame& dropped : dataset.dropped_frames) {
-    logging::warn("dataset build: dropping frame %s: %s", dropped.frame.c_str(), dropped.reason.c_str());
-    remove_tree(dataset.mesh_path(dropped.frame));
-    for (const Camera& camera : dataset.rig.cameras) remove_tree(dataset.image_path(camera.name, dropped.frame));
-  }
+  drop_frames_lacking_images(dataset, options.missing_images, request.capture, kRemedy, "dataset build");
   write_dataset_manifest(dataset);
   validate_dataset(read_dataset(staged.path()));
   staged.commit();

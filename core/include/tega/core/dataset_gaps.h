@@ -49,6 +49,13 @@ void check_missing_image_limits(const MissingImageLimits& limits, const std::str
 void apply_missing_image_limits(Dataset& dataset, const MissingImageLimits& limits,
                                 const std::filesystem::path& source, const std::string& remedy);
 
+// What a producer does once it has written every image it could: applies
+// the limits as above, then removes each dropped frame's mesh and images from
+// dataset.root, warning (as `stage`) with the reason.
+void drop_frames_lacking_images(Dataset& dataset, const MissingImageLimits& limits,
+                                const std::filesystem::path& source, const std::string& remedy,
+                                const std::string& stage);
+
 // One line for reports: "2 missing images (cam01: 1, cam03: 1), 1 dropped
 // frame"; empty when the dataset has no gap.
 std::string dataset_gap_summary(const Dataset& dataset);
