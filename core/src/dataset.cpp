@@ -23,11 +23,18 @@ constexpr int kVersion = 1;
 template <class T>
 T field(const json& object, const char* key, const fs::path& file, const std::string& where) {
   if (!object.contains(key)) throw Error(file, where + " has no '" + key + "'");
-  try {
-    return object.at(key).get<T>();
-  } catch (const json::exception&) {
-    throw Error(file, where + ": '" + key + "' has the wrong type");
-  }
+  return detail::json_as<T>(object.at(key), where + ": " + key, file);
+}
+
+// An optional list of integers (vertex or face indices), checked element by element.
+std::vector<int32_t> optional_indices(const json& manifest, const char* key, const fs::path& file) {
+  if (!manifest.contains(key)) return {};
+  const json& list = manifest.at(key);
+  if (!list.is_array()) throw Error(file, std::string("'") + key + "' must be a list");
+  std::vector<int32_t> out;
+  out.reserve(list.size());
+  for (const json& index : list) out.push_back(detail::json_as<int32_t>(index, key, file));
+  return out;
 }
 
 RigidTransform pose_from_json(const json& rows, const fs::path& file, const std::string& where) {
@@ -137,9 +144,10 @@ static Dataset read_dataset_fields(const fs::path& root) {
   if (!fs::exists(file)) throw Error(root, "is not a tega dataset (no dataset.json)");
   const json manifest = detail::read_json_file(file);
   if (manifest.value("format", "") != kFormat) throw Error(file, "is not a tega dataset manifest (format)");
-  if (manifest.value("version", 0) != kVersion) {
-    throw Error(file, "has dataset version " + std::to_string(manifest.value("version", 0)) +
-                          "; this tega reads version " + std::to_string(kVersion));
+  const int version = manifest.contains("version") ? detail::json_as<int>(manifest.at("version"), "version", file) : 0;
+  if (version != kVersion) {
+    throw Error(file, "has dataset version " + std::to_string(version) + "; this tega reads version " +
+                          std::to_string(kVersion));
   }
 
   Dataset d;
@@ -151,8 +159,8 @@ static Dataset read_dataset_fields(const fs::path& root) {
   if (images == "images/{camera}/{frame}.zst") d.image_extension = ".zst";
   else if (images != "images/{camera}/{frame}.png")
     throw Error(file, "names images '" + images + "'; tega reads images/{camera}/{frame}.png or .zst");
-  d.eyeball_faces = manifest.value("eyeball_faces", std::vector<int32_t>{});
-  d.landmark_vertices = manifest.value("landmark_vertices", std::vector<int32_t>{});
+  d.eyeball_faces = optional_indices(manifest, "eyeball_faces", file);
+  d.landmark_vertices = optional_indices(manifest, "landmark_vertices", file);
   for (int32_t f : d.eyeball_faces) {
     if (f < 0 || f >= d.template_mesh.num_faces()) {
       throw Error(file, "eyeball face " + std::to_string(f) + " is out of range (template has " +

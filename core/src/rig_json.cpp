@@ -6,6 +6,7 @@
 #include <string>
 #include <utility>
 
+#include "json_file.h"
 #include "tega/core/error.h"
 #include "tega/core/files.h"
 #include "tega/core/rig.h"
@@ -50,7 +51,7 @@ class ObjectReader {
 
   int integer(const char* key) const {
     const json& v = field(key);
-    if (!v.is_number_integer()) fail(std::string("field '") + key + "' must be an integer");
+    if (!detail::holds_integer<int>(v)) fail(std::string("field '") + key + "' must be an integer that fits an int");
     return v.get<int>();
   }
 

@@ -28,11 +28,7 @@ template <class T>
 T field(const json& object, const char* key, const fs::path& file, const std::string& where = "") {
   const std::string name = where.empty() ? key : where + "." + key;
   if (!object.is_object() || !object.contains(key)) throw Error(file, "has no '" + name + "'");
-  try {
-    return object.at(key).get<T>();
-  } catch (const json::exception&) {
-    throw Error(file, "'" + name + "' has the wrong type");
-  }
+  return detail::json_as<T>(object.at(key), name, file);
 }
 
 template <class T>

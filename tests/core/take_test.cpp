@@ -126,6 +126,17 @@ TEST_F(TakeTest, MalformedJsonIsNamed) {
   EXPECT_NE(validation_error().find("take.json: has no 'cameras'"), std::string::npos) << validation_error();
 }
 
+// nlohmann converts any number to an int unchecked: a float beyond an int's
+// range is undefined behaviour (found by fuzzing capture.json).
+TEST_F(TakeTest, NumbersOutOfAnIntegersRangeAreNamed) {
+  for (const char* height : {"487e9", "2.5", "3000000000"}) {
+    tega::write_text_atomic(tmp / "capture.json", std::string(R"({"format": "tega-capture", "version": 1,
+                              "cameras": ["cam00"], "width": 4, "height": )") + height + R"(, "takes": []})");
+    const std::string message = tega::test::error_message([&] { tega::read_capture(tmp.path()); });
+    EXPECT_NE(message.find("capture.json: 'height' must be an integer from"), std::string::npos) << message;
+  }
+}
+
 TEST_F(TakeTest, RecordedInACaptureValidates) {
   tega::write_text_atomic(tmp / "capture.json",
                           R"({"format": "tega-capture", "version": 1, "cameras": ["cam00"], "width": 4,
