@@ -53,6 +53,9 @@ int main(int argc, char** argv) {
   app.add_option("--threads", threads, "Worker threads (the target machine has 2 cores).");
   app.add_option("--landmarks", landmarks, "A dlib 68-point shape predictor for the landmark term.");
   app.add_flag("--no-flow", no_flow, "Track without the optical-flow term.");
+  std::vector<int> ignored_landmarks;
+  app.add_option("--ignored-landmarks", ignored_landmarks,
+                 "0-based 68-point landmarks the per-frame fit leaves out (e.g. the eyelids, 36 ... 47).");
   bool detector_boxes = false;
   app.add_flag("--detector-boxes", detector_boxes,
                "Boxes from dlib's face detector (for dlib's own predictor) instead of around the posed model.");
@@ -80,6 +83,7 @@ int main(int argc, char** argv) {
   options.threads = threads;
   options.landmarks.model = landmarks;
   options.landmarks.detector_boxes = detector_boxes;
+  options.landmarks.ignored_points = ignored_landmarks;
   options.flow.enabled = !no_flow;
   const tracking::HeadModel model = tracking::load_head_model(model_dir, options.model_metres_per_unit);
   const std::unique_ptr<tracking::LandmarkDetector> detector =

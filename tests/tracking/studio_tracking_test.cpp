@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "small_studio.h"
+#include "test_support.h"
 #include "tega/core/files.h"
 #include "tega/core/mesh.h"
 #include "tega/core/rig.h"
@@ -185,6 +186,12 @@ TEST(StudioTracking, TracksTegasOwnMeshesWithinTheTargets) {
   EXPECT_FALSE(fs::exists(dir / "tracked_with_gap" / "expressions" / "000005.bin"));
   const auto summary_json = nlohmann::json::parse(read_text_file(dir / "tracked_with_gap" / "expressions" / "track.json"));
   EXPECT_EQ(summary_json["frames_not_tracked"].size(), 1u);
+
+  reuse.landmarks.ignored_points = {36, 68};
+  const std::string bad_point =
+      test::error_message([&] { track_capture({capture, {}, dir / "true_meshes", dir / "tracked_bad", {}}, reuse); });
+  EXPECT_NE(bad_point.find("landmarks.ignored_points holds 68; points are numbered 0 to 67"), std::string::npos)
+      << bad_point;
 }
 
 }  // namespace

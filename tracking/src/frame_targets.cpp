@@ -113,8 +113,12 @@ Term<ImageTarget> landmark_targets(const HeadModel& model, const PosedModel& pos
     const std::vector<int> inner(model.landmark_vertices.begin() + kFirstInnerLandmark, model.landmark_vertices.end());
     const std::vector<bool> visible = visible_from(camera.center(), posed, inner, scan);
     std::lock_guard lock(mutex);
-    for (size_t i = 0; i < inner.size(); ++i)
-      if (visible[i]) term.targets.push_back({inner[i], int(c), (*found)[kFirstInnerLandmark + i]});
+    for (size_t i = 0; i < inner.size(); ++i) {
+      const int point = kFirstInnerLandmark + int(i);
+      const bool ignored = std::find(options.ignored_points.begin(), options.ignored_points.end(), point) !=
+                           options.ignored_points.end();
+      if (visible[i] && !ignored) term.targets.push_back({inner[i], int(c), (*found)[size_t(point)]});
+    }
   });
   sort_targets(term);
   return term;

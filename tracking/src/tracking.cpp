@@ -186,6 +186,9 @@ TrackSummary track_capture(const TrackRequest& request, const Options& options) 
       throw Error(request.meshes / name, "is missing: take " + name + " has no meshes (run tega mvs first)");
 
   if (options.model.empty()) throw Error("track: no head model: set the model option (tega track --model DIR)");
+  for (const int point : options.landmarks.ignored_points)
+    if (point < 0 || point >= 68)
+      throw Error("track: landmarks.ignored_points holds " + std::to_string(point) + "; points are numbered 0 to 67");
   const HeadModel model = load_head_model(options.model, options.model_metres_per_unit);
   std::unique_ptr<LandmarkDetector> landmarks;
   if (!options.landmarks.model.empty()) landmarks = std::make_unique<LandmarkDetector>(options.landmarks.model);

@@ -78,6 +78,7 @@ struct LandmarkOptions {
   ImageTermOptions term{2.0, 0.3, 3.0};
   int min_views = 2;  // landmarks seen in fewer views are not used for the first pose
   bool detector_boxes = false;  // dlib's face detector's boxes instead of the projected model's
+  std::vector<int> ignored_points;  // 0-based 68-point indices left out of the per-frame term
 
   template <class V>
   void visit(V& v) {
@@ -87,6 +88,9 @@ struct LandmarkOptions {
     v("detector_boxes", detector_boxes,
       "Find faces with dlib's frontal face detector (the boxes dlib's own predictor was trained on) instead of "
       "around the projected model's landmarks (the boxes train_landmark_predictor uses).");
+    v("ignored_points", ignored_points,
+      "Landmarks (0-based, iBUG 68-point numbering) the per-frame fit leaves out, e.g. [36, 37, ..., 47] for the "
+      "eyelids with dlib's stock predictor, whose eye points do not follow closing lids (docs/tracking.md).");
   }
 };
 
