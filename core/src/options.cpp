@@ -82,6 +82,11 @@ void assign(OptionField& field, const YAML::Node& value, const std::string& key,
 void apply_node(std::vector<OptionField>& fields, const YAML::Node& map, const std::string& prefix,
                 const std::string& source) {
   for (const auto& entry : map) {
+    if (!entry.first.IsScalar()) {
+      const std::string within = prefix.empty() ? "" : " in '" + prefix.substr(0, prefix.size() - 1) + "'";
+      throw Error(source, "an option name" + location(entry.first) + within +
+                              " is a list or mapping; option names are plain words");
+    }
     const auto key = entry.first.as<std::string>();
     auto it = std::find_if(fields.begin(), fields.end(), [&](const OptionField& f) { return f.key == key; });
     if (it == fields.end()) {

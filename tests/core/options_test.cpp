@@ -71,6 +71,14 @@ TEST(Options, UnknownKeyIsAnErrorNamingFileKeyAndKnownKeys) {
   const auto nested =
       error_of([&] { tega::load_options_from_string(o, "smoothness: {middle: 1}\n", "", "studio.yaml"); });
   EXPECT_NE(nested.find("'smoothness.middle'"), std::string::npos) << nested;
+
+  // A name that is a list or a mapping (found by fuzzing: yaml-cpp's BadConversion escaped).
+  const auto list_name = error_of([&] { tega::load_options_from_string(o, "[cameras]: 4\n", "", "studio.yaml"); });
+  EXPECT_NE(list_name.find("studio.yaml: an option name (line 1) is a list or mapping"), std::string::npos)
+      << list_name;
+  const auto nested_name =
+      error_of([&] { tega::load_options_from_string(o, "smoothness: {{a: 1}: 2}\n", "", "studio.yaml"); });
+  EXPECT_NE(nested_name.find("in 'smoothness' is a list or mapping"), std::string::npos) << nested_name;
 }
 
 TEST(Options, WrongTypeIsAnErrorWithLine) {
