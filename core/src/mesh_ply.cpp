@@ -347,12 +347,32 @@ void append_binary(std::string& out, T value) {
   out.append(bytes, sizeof(T));
 }
 
+// Each element's count against what the body can hold, before anything is
+// read or reserved: a damaged count would otherwise make the reader reserve
+// terabytes or loop for ages over items that carry no data.
+void check_counts(const std::filesystem::path& file, const PlyHeader& header, size_t body_bytes) {
+  for (const PlyElement& element : header.elements) {
+    if (element.count == 0) continue;
+    if (element.properties.empty())
+      throw Error(file, "PLY element '" + element.name + "' has " + std::to_string(element.count) +
+                            " items but no properties");
+    // Binary: at least each scalar or list length; ASCII: at least a character for each.
+    int64_t bytes_per_item = 0;
+    for (const PlyProperty& property : element.properties)
+      bytes_per_item += header.binary ? type_size(property.is_list ? property.count_type : property.type) : 1;
+    if (element.count > int64_t(body_bytes) / bytes_per_item)
+      throw Error(file, "PLY element '" + element.name + "' declares " + std::to_string(element.count) +
+                            " items, more than the file's " + std::to_string(body_bytes) + " bytes of data can hold");
+  }
+}
+
 }  // namespace
 
 Mesh read_ply(const std::filesystem::path& file) {
   const std::string text = read_text_file(file);
   const PlyHeader header = parse_header(file, text);
   const std::string_view body = std::string_view(text).substr(header.body_offset);
+  check_counts(file, header, body.size());
   if (header.binary) {
     BinarySource source(file, body);
     return read_body(file, header, source);

@@ -124,7 +124,7 @@ Rig read_rig_json(const std::filesystem::path& file) {
   json doc;
   try {
     doc = json::parse(read_text_file(file));
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {
     throw Error(file, std::string("not valid JSON: ") + e.what());
   }
   if (!doc.is_object()) throw Error(file, "expected a JSON object at the top level");

@@ -208,6 +208,17 @@ TEST(MeshPly, BadInputNamesFile) {
                    "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
                    "end_header\n0 0 0\n1 0 0\n0 1\n");
   EXPECT_NE(error_message([&] { read_ply(file); }).find("ends early"), std::string::npos);
+  // Counts no body could hold (found by fuzzing: the reader reserved or looped for them).
+  test::write_text(file, "ply\nformat ascii 1.0\nelement vertex 444444444444\nproperty float x\nproperty float y\n"
+                         "property float z\nend_header\n0 0 0\n");
+  message = error_message([&] { read_ply(file); });
+  EXPECT_NE(message.find("PLY element 'vertex' declares 444444444444 items, more than the file's 6 bytes"),
+            std::string::npos)
+      << message;
+  test::write_text(file, "ply\nformat ascii 1.0\nelement nothing 444444444444\nend_header\n");
+  message = error_message([&] { read_ply(file); });
+  EXPECT_NE(message.find("PLY element 'nothing' has 444444444444 items but no properties"), std::string::npos)
+      << message;
 }
 
 TEST(MeshBin, RoundTripAndCountChecks) {
