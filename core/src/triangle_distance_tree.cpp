@@ -1,6 +1,7 @@
 #include "tega/core/triangle_distance_tree.h"
 
 #include <algorithm>
+#include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -12,6 +13,41 @@ constexpr int kLeafTriangles = 4;
 
 double squared_distance_to_box(const Eigen::Vector3d& p, const Eigen::Vector3d& lower, const Eigen::Vector3d& upper) {
   return (lower - p).cwiseMax(p - upper).cwiseMax(0.0).squaredNorm();
+}
+
+// Whether the segment from + t d, 0 < t < 1, meets the box (slab test).
+bool segment_meets_box(const Eigen::Vector3d& from, const Eigen::Vector3d& inverse_d, const Eigen::Vector3d& lower,
+                       const Eigen::Vector3d& upper) {
+  double enter = 0, leave = 1;
+  for (int k = 0; k < 3; ++k) {
+    double t0 = (lower[k] - from[k]) * inverse_d[k], t1 = (upper[k] - from[k]) * inverse_d[k];
+    if (std::isnan(t0) || std::isnan(t1)) {  // along the slab's plane: inside it or not
+      if (from[k] < lower[k] || from[k] > upper[k]) return false;
+      continue;
+    }
+    if (t0 > t1) std::swap(t0, t1);
+    enter = std::max(enter, t0);
+    leave = std::min(leave, t1);
+    if (enter > leave) return false;
+  }
+  return true;
+}
+
+// Möller-Trumbore: whether from + t d meets the triangle at some 0 < t < 1.
+bool segment_meets_triangle(const Eigen::Vector3d& from, const Eigen::Vector3d& d, const Eigen::Vector3d& a,
+                            const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d e1 = b - a, e2 = c - a, h = d.cross(e2);
+  const double det = e1.dot(h);
+  if (std::abs(det) < 1e-300) return false;  // parallel to the plane
+  const double inverse = 1 / det;
+  const Eigen::Vector3d s = from - a;
+  const double u = inverse * s.dot(h);
+  if (u < 0 || u > 1) return false;
+  const Eigen::Vector3d q = s.cross(e1);
+  const double v = inverse * d.dot(q);
+  if (v < 0 || u + v > 1) return false;
+  const double t = inverse * e2.dot(q);
+  return t > 0 && t < 1;
 }
 
 }  // namespace
@@ -114,6 +150,27 @@ TriangleDistanceTree::Closest TriangleDistanceTree::closest(const Eigen::Vector3
   if (!nodes_.empty()) search(0, point, best_squared, best);
   best.distance = std::sqrt(best_squared);
   return best;
+}
+
+bool TriangleDistanceTree::crosses(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const {
+  if (nodes_.empty()) return false;
+  const Eigen::Vector3d d = to - from, inverse_d = d.cwiseInverse();
+  std::vector<int> stack = {0};
+  while (!stack.empty()) {
+    const Node& node = nodes_[size_t(stack.back())];
+    stack.pop_back();
+    if (!segment_meets_box(from, inverse_d, node.lower, node.upper)) continue;
+    if (node.left >= 0) {
+      stack.push_back(node.left);
+      stack.push_back(node.right);
+      continue;
+    }
+    for (int i = node.first; i < node.first + node.count; ++i) {
+      const Triangle& t = triangles_[size_t(i)];
+      if (segment_meets_triangle(from, d, t.a, t.b, t.c)) return true;
+    }
+  }
+  return false;
 }
 
 double TriangleDistanceTree::distance(const Eigen::Vector3d& point) const { return closest(point).distance; }

@@ -46,5 +46,36 @@ TEST(TriangleDistanceTree, ClosestPointAndFaceMatchBruteForce) {
   EXPECT_EQ(TriangleDistanceTree(Mesh{}).closest(Eigen::Vector3d::Zero()).face, -1);
 }
 
+// Lines of sight over the grid (|z| <= 0.05 inside 0 <= x, y <= 1): a
+// segment from above to below it always crosses it; one that stays above, ends
+// short of it or passes beside it never does.
+TEST(TriangleDistanceTree, SegmentsCrossTheSurfaceExactlyWhenTheyPassThroughIt) {
+  const Mesh mesh = bumpy_grid(24);
+  const TriangleDistanceTree tree(mesh);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> inside(0.01, 0.99), beside(1.05, 2.0);
+  for (int i = 0; i < 300; ++i) {
+    const Eigen::Vector3d above(inside(rng), inside(rng), 1), below(inside(rng), inside(rng), -1);
+    EXPECT_TRUE(tree.crosses(above, below));
+    EXPECT_TRUE(tree.crosses(below, above));
+    EXPECT_FALSE(tree.crosses(above, Eigen::Vector3d(below.x(), below.y(), 0.06)));
+    EXPECT_FALSE(tree.crosses(above, Eigen::Vector3d(inside(rng), inside(rng), 0.5)));
+    EXPECT_FALSE(tree.crosses(Eigen::Vector3d(beside(rng), inside(rng), 1), Eigen::Vector3d(beside(rng), inside(rng), -1)));
+  }
+  EXPECT_FALSE(tree.crosses(Eigen::Vector3d(-0.5, 0.5, 0), Eigen::Vector3d(-0.1, 0.5, 0)));  // in its plane, beside it
+  EXPECT_FALSE(TriangleDistanceTree(Mesh{}).crosses(Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()));
+  // A single triangle, the segment's ends excluded.
+  Mesh one;
+  one.positions.resize(3, 3);
+  one.positions << -1, -1, 0, 1, -1, 0, 0, 1, 0;
+  one.faces.resize(1, 3);
+  one.faces << 0, 1, 2;
+  const TriangleDistanceTree single(one);
+  EXPECT_TRUE(single.crosses(Eigen::Vector3d(0, 0, -1), Eigen::Vector3d(0, 0, 1)));
+  EXPECT_FALSE(single.crosses(Eigen::Vector3d(0, 0, -1), Eigen::Vector3d(0, 0, -0.01)));
+  EXPECT_FALSE(single.crosses(Eigen::Vector3d(5, 5, -1), Eigen::Vector3d(5, 5, 1)));
+  EXPECT_FALSE(single.crosses(Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0.5, 0, 1)));  // parallel, above
+}
+
 }  // namespace
 }  // namespace tega

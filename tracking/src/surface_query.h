@@ -1,13 +1,13 @@
 #pragma once
-// Questions to a scanned surface (a frame's multi-view stereo mesh), asked
-// in batches: the closest surface point to each query point (core's exact
-// triangle tree; Debian's Open3D 0.16 aborts on an assertion in its
-// closest-point query for some Poisson meshes), and whether the straight
-// line from a camera to a point is blocked (Open3D's ray casting, Embree).
+// Questions to a surface (a frame's multi-view stereo mesh, the model's
+// lids), asked in batches and answered by core's triangle tree: the closest
+// surface point to each query point, and whether the straight line from a
+// camera to a point is blocked. Debian's Open3D 0.16 serves neither: its
+// closest-point query aborts on an assertion for some Poisson meshes, and
+// its ray casting finds no hit at all (not even a ray through a single
+// triangle: tests/tracking/surface_query_test.cpp).
 
 #include <Eigen/Core>
-#include <memory>
-#include <mutex>
 #include <vector>
 
 #include "tega/core/mesh.h"
@@ -23,9 +23,6 @@ struct ClosestPoint {
 class SurfaceQuery {
  public:
   explicit SurfaceQuery(const Mesh& surface);
-  ~SurfaceQuery();
-  SurfaceQuery(const SurfaceQuery&) = delete;
-  SurfaceQuery& operator=(const SurfaceQuery&) = delete;
 
   std::vector<ClosestPoint> closest(const std::vector<Eigen::Vector3d>& points) const;
   // For each point: does the surface cross the segment from `eye` to the
@@ -34,14 +31,8 @@ class SurfaceQuery {
                              double margin_m) const;
 
  private:
-  struct Scene;
-  Scene& scene() const;
-
-  Mesh surface_;
   TriangleDistanceTree tree_;
   Vertices face_normals_;
-  mutable std::once_flag scene_built_;
-  mutable std::unique_ptr<Scene> scene_;
 };
 
 }  // namespace tega::tracking

@@ -2,7 +2,8 @@
 // Exact closest points on a triangle mesh: a bounding-volume hierarchy over
 // the triangles, searched nearest box first and pruned by the best distance
 // found so far, so the answer is the exact point-to-triangle minimum. Used to
-// score surfaces (mvs/) and to find the scan under a model (tracking/).
+// score surfaces (mvs/) and to find the scan under a model (tracking/); the
+// same hierarchy answers whether a line of sight is blocked (tracking/).
 
 #include <Eigen/Core>
 #include <vector>
@@ -25,6 +26,9 @@ class TriangleDistanceTree {
     double distance = 0;
   };
   Closest closest(const Eigen::Vector3d& point) const;
+
+  // Whether a triangle crosses the segment from `from` to `to` (ends excluded).
+  bool crosses(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const;
 
  private:
   struct Triangle {
