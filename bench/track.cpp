@@ -8,7 +8,9 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "tega/core/error.h"
 #include "tega/core/mesh.h"
+#include "tega/core/options.h"
 #include "tega/core/rig.h"
 #include "tega/core/take.h"
 #include "tega/core/thread_pool.h"
@@ -46,6 +48,8 @@ int main(int argc, char** argv) {
   bool no_flow = false;
   app.add_option("--model", model_dir, "The ICT-FaceKit directory.");
   app.add_option("--capture", capture_dir, "A virtual-studio capture to track (default: render one).");
+  std::vector<std::string> overrides;
+  app.add_option("--set", overrides, "Override a tracking option, e.g. --set eyelids.enabled=false (repeatable).");
   app.add_option("--meshes", meshes_dir, "Its MVS meshes (MESHES/expressions/<frame>.ply; default: the true meshes).");
   app.add_option("--frames", frames, "Frames of the take to render and track.");
   app.add_option("--width", width, "Image width of the rendered capture.");
@@ -61,6 +65,22 @@ int main(int argc, char** argv) {
                "Boxes from dlib's face detector (for dlib's own predictor) instead of around the posed model.");
   CLI11_PARSE(app, argc, argv);
 
+  tracking::Options options;
+  options.threads = threads;
+  options.landmarks.model = landmarks;
+  options.landmarks.detector_boxes = detector_boxes;
+  options.landmarks.ignored_points = ignored_landmarks;
+  options.flow.enabled = !no_flow;
+  try {
+    for (const auto& kv : overrides) {
+      const auto eq = kv.find('=');
+      if (eq == std::string::npos) throw Error("--set " + kv + ": expected key=value");
+      set_option(options, kv.substr(0, eq), kv.substr(eq + 1));
+    }
+  } catch (const Error& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return 2;
+  }
   fs::path capture = capture_dir;
   if (capture.empty()) {
     capture = fs::temp_directory_path() / "tega-track-bench";
@@ -79,12 +99,6 @@ int main(int argc, char** argv) {
     synth::render_virtual_studio(studio, capture, true);
   }
 
-  tracking::Options options;
-  options.threads = threads;
-  options.landmarks.model = landmarks;
-  options.landmarks.detector_boxes = detector_boxes;
-  options.landmarks.ignored_points = ignored_landmarks;
-  options.flow.enabled = !no_flow;
   const tracking::HeadModel model = tracking::load_head_model(model_dir, options.model_metres_per_unit);
   const std::unique_ptr<tracking::LandmarkDetector> detector =
       landmarks.empty() ? nullptr : std::make_unique<tracking::LandmarkDetector>(landmarks);
@@ -104,8 +118,8 @@ int main(int argc, char** argv) {
   std::printf("identity fit: %.2f s (once per subject)\n", seconds_since(start));
 
   tracking::TakeTracker tracker(model, subject, rig.cameras, options, detector.get());
-  std::printf("%-6s %10s %12s %12s %12s %10s %12s %12s\n", "frame", "scan faces", "image terms", "pose+expr",
-              "corrections", "total (s)", "flow points", "flow rms px");
+  std::printf("%-6s %10s %12s %12s %12s %10s %12s %12s   %s\n", "frame", "scan faces", "image terms", "pose+expr",
+              "corrections", "total (s)", "flow points", "flow rms px", "blink (eye covered in the photos)");
   double total = 0;
   int counted = 0;
   std::vector<tracking::ScoredFrame> scored;
@@ -120,9 +134,14 @@ int main(int argc, char** argv) {
     for (size_t k = 0; k < fit.state.expression.size(); ++k)
       t.expression[model.shapes.expression_names[k]] = fit.state.expression[k];
     scored.push_back(std::move(t));
-    std::printf("%-6d %10d %12.2f %12.2f %12.2f %10.2f %12d %12.2f\n", frame, scan.num_faces(), fit.timings.image_terms_s,
+    std::printf("%-6d %10d %12.2f %12.2f %12.2f %10.2f %12d %12.2f ", frame, scan.num_faces(), fit.timings.image_terms_s,
                 fit.timings.coefficients_s, fit.timings.corrections_s, seconds, fit.residuals.flow_count,
                 fit.residuals.flow_rms_px);
+    for (const auto& name : options.eyelids.shapes) {
+      std::printf("  %s %.2f", name.c_str(), scored.back().expression.at(name));
+      if (fit.residuals.eyelids_covered.count(name)) std::printf(" (%.2f)", fit.residuals.eyelids_covered.at(name));
+    }
+    std::printf("\n");
     if (frame > 0) total += seconds, ++counted;  // frame 0 also finds the first pose
   }
   if (counted) std::printf("mean over frames 1..%d: %.2f s per frame (%d threads)\n", take.frames - 1, total / counted, threads);

@@ -168,6 +168,27 @@ TEST(Tracker, AScanFarFromTheHeadIsRejectedNotTracked) {
   EXPECT_NE(reason->find("of the face lies within"), std::string::npos) << *reason;
 }
 
+// The eyelid term pairs each eye with one of its blink shapes; what it
+// cannot pair is an error, not an eye left open.
+TEST(Tracker, EyelidShapesThatCannotBePairedAreNamed) {
+  const auto dir = ict_model();
+  if (!dir) GTEST_SKIP() << "ICT-FaceKit is not in ../shared/data";
+  const HeadModel model = load_head_model(*dir, 0.01);
+  const SubjectIdentity subject{{}, model.shapes.neutral.positions, {}};
+  const auto message = [&](std::vector<std::string> shapes) {
+    Options options = scan_only_options();
+    options.eyelids.shapes = std::move(shapes);
+    return test::error_message([&] { TakeTracker(model, subject, {}, options, nullptr); });
+  };
+  EXPECT_NE(message({"eyeBlink_L", "winkLeft"}).find("has no expression shape winkLeft"), std::string::npos);
+  EXPECT_NE(message({"eyeBlink_L", "eyeBlink_L"}).find("both eyes pair with the shape eyeBlink_L"), std::string::npos);
+  EXPECT_NE(message({"eyeBlink_L"}).find("eyelids.shapes must name two shapes"), std::string::npos);
+  // Named the other way round, each shape still finds its own eye.
+  Options swapped = scan_only_options();
+  swapped.eyelids.shapes = {"eyeBlink_R", "eyeBlink_L"};
+  EXPECT_NO_THROW(TakeTracker(model, subject, {}, swapped, nullptr));
+}
+
 TEST(HeadModel, MismatchedShapesAndIndexSetsAreNamed) {
   const auto dir = ict_model();
   if (!dir) GTEST_SKIP() << "ICT-FaceKit is not in ../shared/data";

@@ -25,6 +25,7 @@ nlohmann::json residuals_json(const FrameResiduals& r) {
                       {"inlier_fraction", r.inlier_fraction}};
   if (r.landmark_count > 0) j["landmark_rms_px"] = r.landmark_rms_px, j["landmarks"] = r.landmark_count;
   if (r.flow_count > 0) j["flow_rms_px"] = r.flow_rms_px, j["flow_points"] = r.flow_count;
+  if (!r.eyelids_covered.empty()) j["eyelids_covered"] = r.eyelids_covered;
   return j;
 }
 
@@ -37,6 +38,7 @@ FrameResiduals residuals_of(const nlohmann::json& j) {
   r.landmark_count = j.value("landmarks", 0);
   r.flow_rms_px = j.value("flow_rms_px", -1.0);
   r.flow_count = j.value("flow_points", 0);
+  if (j.contains("eyelids_covered")) r.eyelids_covered = j.at("eyelids_covered").get<std::map<std::string, double>>();
   return r;
 }
 

@@ -23,6 +23,7 @@ void write_identity(const SubjectIdentity& subject, const HeadModel& model, cons
     coefficients[model.shapes.identity_names[k]] = subject.coefficients[k];
   j["identity"] = coefficients;
   j["neutral"] = mesh_file.filename().string();
+  if (!subject.open_eyes_covered.empty()) j["open_eyes_covered"] = subject.open_eyes_covered;
   // What later stages need of the model without loading it (tracked.h).
   j["eyeball_vertex_runs"] = vertex_runs(model.eyeball_vertices);
   j["landmark_vertices"] = model.landmark_vertices;
@@ -42,6 +43,8 @@ SubjectIdentity read_identity(const fs::path& file, const HeadModel& model) {
     for (const auto& name : model.shapes.identity_names)
       subject.coefficients.push_back(coefficients.contains(name) ? coefficients.at(name).get<double>() : 0.0);
     mesh_file = file.parent_path() / j.at("neutral").get<std::string>();
+    if (j.contains("open_eyes_covered"))
+      subject.open_eyes_covered = j.at("open_eyes_covered").get<std::map<std::string, double>>();
   } catch (const nlohmann::json::exception& e) {
     throw Error(file, std::string("is not a valid identity file: ") + e.what());
   }

@@ -166,6 +166,33 @@ class DeviationCost final : public ceres::CostFunction {
   double inverse_sigma_;
 };
 
+// A coefficient's distance outside its range, over sigma.
+class RangeCost : public ceres::CostFunction {
+ public:
+  RangeCost(long count, const CoefficientRange& range, double sigma)
+      : k_(range.coefficient), low_(range.low), high_(range.high), inverse_sigma_(1 / sigma) {
+    set_num_residuals(1);
+    mutable_parameter_block_sizes()->push_back(static_cast<int32_t>(count));
+    count_ = count;
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const double s = parameters[0][k_];
+    const double slope = s < low_ ? -1 : s > high_ ? 1 : 0;
+    residuals[0] = inverse_sigma_ * (s < low_ ? low_ - s : s > high_ ? s - high_ : 0);
+    if (jacobians && jacobians[0]) {
+      std::fill(jacobians[0], jacobians[0] + count_, 0.0);
+      jacobians[0][k_] = inverse_sigma_ * slope;
+    }
+    return true;
+  }
+
+ private:
+  long count_ = 0;
+  int k_;
+  double low_, high_, inverse_sigma_;
+};
+
 // (a - b) / sigma for two 3-vectors: the membrane between neighbouring corrections.
 struct EdgeDifference {
   double inverse_sigma;
@@ -273,6 +300,10 @@ void fit_coefficients(const CoefficientProblem& p, std::vector<RigidTransform>& 
     Eigen::VectorXd mean = Eigen::VectorXd::Zero(K);
     for (long k = 0; k < std::min<long>(K, long(p.prior_mean.size())); ++k) mean[k] = p.prior_mean[size_t(k)];
     problem.AddResidualBlock(new DeviationCost(mean, p.prior_sigma), loss_of(p.prior_scale, 1), s.data());
+    ceres::LossFunction* range_loss = loss_of(p.ranges.scale, p.ranges.targets.size());
+    for (const auto& range : p.ranges.targets)
+      if (range.coefficient >= 0 && range.coefficient < K)
+        problem.AddResidualBlock(new RangeCost(K, range, p.ranges.scale.sigma), range_loss, s.data());
     for (long k = 0; k < K; ++k) {
       if (k < long(p.lower.size())) problem.SetParameterLowerBound(s.data(), int(k), p.lower[size_t(k)]);
       if (k < long(p.upper.size())) problem.SetParameterUpperBound(s.data(), int(k), p.upper[size_t(k)]);

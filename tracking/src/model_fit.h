@@ -48,6 +48,13 @@ struct FrameTargets {
   std::vector<Term<ImageTarget>> images;  // flow, landmarks, ...
 };
 
+// A coefficient should lie in [low, high]; outside, it costs its distance
+// to the range over the term's sigma.
+struct CoefficientRange {
+  int coefficient = 0;
+  double low = 0, high = 1;
+};
+
 struct CoefficientProblem {
   const Vertices* base = nullptr;           // V x 3, head space, corrections included
   const std::vector<Vertices>* basis = nullptr;  // K shapes, V x 3 each
@@ -55,6 +62,7 @@ struct CoefficientProblem {
   std::vector<double> prior_mean;           // coefficients are drawn towards these ...
   double prior_sigma = 1;                   // ... with this spread
   TermScale prior_scale;                    // (the prior's share of the energy; sigma unused)
+  Term<CoefficientRange> ranges;            // e.g. the blinks the photos show
   const std::vector<Camera>* cameras = nullptr;
   // Per frame: its targets, and a prior on its pose (previous frame's) when set.
   std::vector<FrameTargets> frames;

@@ -20,4 +20,12 @@ RigidTransform align(const std::vector<Eigen::Vector3d>& from, const std::vector
   return pose;
 }
 
+Vertices posed(const Vertices& head, const RigidTransform& pose) {
+  Vertices world(head.rows(), 3);
+  const Eigen::Matrix3f R = pose.R.cast<float>();
+  const Eigen::RowVector3f t = pose.t.cast<float>().transpose();
+  for (Eigen::Index v = 0; v < head.rows(); ++v) world.row(v) = head.row(v) * R.transpose() + t;
+  return world;
+}
+
 }  // namespace tega::tracking

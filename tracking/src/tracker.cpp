@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "eyelids.h"
 #include "frame_targets.h"
 #include "rigid_alignment.h"
 #include "tega/core/error.h"
@@ -21,14 +22,6 @@ Vertices with_shapes(Vertices base, const std::vector<Vertices>& shapes, const s
   for (size_t k = 0; k < std::min(shapes.size(), coefficients.size()); ++k)
     if (coefficients[k] != 0) base += static_cast<float>(coefficients[k]) * shapes[k];
   return base;
-}
-
-Vertices posed(const Vertices& head, const RigidTransform& pose) {
-  Vertices world(head.rows(), 3);
-  const Eigen::Matrix3f R = pose.R.cast<float>();
-  const Eigen::RowVector3f t = pose.t.cast<float>().transpose();
-  for (Eigen::Index v = 0; v < head.rows(); ++v) world.row(v) = head.row(v) * R.transpose() + t;
-  return world;
 }
 
 // The ICP bound of iteration `it` of `count`: from max_distance_m down to final_distance_m.
@@ -51,6 +44,30 @@ CorrectionProblem correction_problem(const std::vector<int>& vertices, const Opt
   p.iterations = o.solver_iterations;
   p.threads = options.threads;
   return p;
+}
+
+// How much of each open eye the identity frames show as skin, averaged.
+std::map<std::string, double> open_eyes_covered(const HeadModel& model, const SubjectIdentity& subject,
+                                                const std::vector<FrameObservation>& frames,
+                                                const std::vector<RigidTransform>& poses,
+                                                const std::vector<Camera>& cameras, const Options& options) {
+  const ModelEyes eyes = find_model_eyes(model, options.eyelids);
+  std::map<std::string, std::pair<double, int>> sums;
+  for (size_t f = 0; f < frames.size(); ++f) {
+    if (frames[f].images.empty()) continue;
+    HeadState open;
+    open.head_to_world = poses[f];
+    open.expression.assign(model.shapes.expression_deltas.size(), 0.0);
+    for (const auto& eye : observe_eyelids(eyes, model, subject.neutral, open, frames[f].images, cameras, {},
+                                           options.eyelids)) {
+      auto& [sum, count] = sums[model.shapes.expression_names[size_t(eye.blink)]];
+      sum += eye.seen_covered;
+      ++count;
+    }
+  }
+  std::map<std::string, double> covered;
+  for (const auto& [name, sum] : sums) covered[name] = sum.first / sum.second;
+  return covered;
 }
 
 }  // namespace
@@ -122,7 +139,10 @@ SubjectIdentity fit_identity(const HeadModel& model, const std::vector<FrameObse
     }
     const RigidTransform rigid_part = align(detailed, shaped);
     subject.neutral = posed(subject.neutral + detail, rigid_part);
+    for (auto& pose : poses) pose = pose * rigid_part.inverse();  // the same world vertices
   }
+  if (options.eyelids.enabled)
+    subject.open_eyes_covered = open_eyes_covered(model, subject, frames, poses, cameras, options);
   return subject;
 }
 
@@ -140,7 +160,9 @@ TakeTracker::TakeTracker(const HeadModel& model, const SubjectIdentity& subject,
       cameras_(std::move(cameras)),
       options_(options),
       landmarks_(landmarks),
-      fit_edges_(edges_between(model.shapes.neutral.faces, model.fit_vertices)) {}
+      fit_edges_(edges_between(model.shapes.neutral.faces, model.fit_vertices)) {
+  if (options.eyelids.enabled) eyes_ = std::make_unique<ModelEyes>(find_model_eyes(model, options.eyelids));
+}
 
 TakeTracker::~TakeTracker() = default;
 
@@ -188,10 +210,25 @@ FrameFit TakeTracker::track(const FrameObservation& frame) {
   }
   std::vector<RigidTransform> poses = {state.head_to_world};
   const std::vector<int> coefficient_vertices = model_.fit_vertices_every(o.surface.coefficient_vertex_step);
+  Term<CoefficientRange> blinks;
+  blinks.scale = {o.eyelids.sigma, o.eyelids.weight, 0};
   for (int it = 0; it < o.icp_iterations; ++it) {
     const PosedModel now = posed_model(model_, pose_vertices(model_, subject_, state));
     // The first iteration fixes the pose on what no expression moves.
     const bool pose_only = it == 0;
+    // The eyelids are observed once the head is in place and the rest of
+    // the face has been fitted (a smile's cheeks narrow the eyes too).
+    if (it >= 2 && eyes_ && has_images) {
+      const auto started = std::chrono::steady_clock::now();
+      blinks.targets.clear();
+      const Vertices head = with_shapes(base, model_.shapes.expression_deltas, state.expression);
+      for (const auto& eye : observe_eyelids(*eyes_, model_, head, state, frame.images, cameras_,
+                                             subject_.open_eyes_covered, o.eyelids)) {
+        blinks.targets.push_back({eye.blink, eye.low, eye.high});
+        fit.residuals.eyelids_covered[model_.shapes.expression_names[size_t(eye.blink)]] = eye.covered;
+      }
+      fit.timings.image_terms_s += seconds_since(started);
+    }
     CoefficientProblem p;
     p.base = &base;
     p.basis = &model_.shapes.expression_deltas;
@@ -200,6 +237,7 @@ FrameFit TakeTracker::track(const FrameObservation& frame) {
     p.prior_mean = prior_mean;
     p.prior_sigma = prior_sigma;
     p.prior_scale = {1, co.weight, 0};
+    p.ranges = blinks;
     p.cameras = &cameras_;
     const double bound = distance_bound(o.surface, it, o.icp_iterations);
     p.frames.push_back({surface_targets(now, pose_only ? model_.pose_vertices : coefficient_vertices, scan, bound,

@@ -63,7 +63,9 @@ struct TakeContext {
   std::string made_with;
 };
 
-bool needs_photos(const Options& o, const LandmarkDetector* landmarks) { return o.flow.enabled || landmarks; }
+bool needs_photos(const Options& o, const LandmarkDetector* landmarks) {
+  return o.flow.enabled || o.eyelids.enabled || landmarks;
+}
 
 void track_take(const TakeContext& t, const Options& options, TrackSummary& summary, ThreadPool& pool) {
   const fs::path options_file = t.out / "made_with.yaml";
@@ -166,7 +168,7 @@ SubjectIdentity identity_of(const TrackRequest& request, const TakeInfo& first, 
       throw Error(scan_file, "is missing: the identity is fitted to frame " + std::to_string(frame) + " of take " +
                                  first.name + " (identity_frames)");
     scans.push_back(read_mesh(scan_file));
-    photos.push_back(landmarks ? frame_photos(first, frame, pool) : std::vector<Image8>{});
+    photos.push_back(needs_photos(options, landmarks) ? frame_photos(first, frame, pool) : std::vector<Image8>{});
   }
   std::vector<FrameObservation> frames;
   for (size_t i = 0; i < scans.size(); ++i) frames.push_back({&scans[i], photos[i]});

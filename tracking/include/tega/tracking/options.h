@@ -94,6 +94,44 @@ struct LandmarkOptions {
   }
 };
 
+// Eyelid closure seen in the photos (docs/tracking.md#eyelids): the fraction
+// of each open eye's eyeball that the photos show covered by skin, against
+// what the model's lid covers at each value of the eye's blink shape.
+struct EyelidOptions {
+  bool enabled = true;
+  std::vector<std::string> shapes = {"eyeBlink_L", "eyeBlink_R"};
+  double sigma = 0.05;               // blink values outside the agreeing range cost (distance / sigma)^2
+  double weight = 0.3;
+  double tolerance = 0.1;            // covered fractions that differ by at most this agree
+  double max_view_angle_deg = 45;    // cameras farther than this from the eye's front are not used
+  int sample_step = 3;               // every n-th eyeball vertex is tested
+  int min_samples = 30;              // an eye seen at fewer eyeball points is left out of the frame
+  double skin_distance_factor = 1.5;  // a pixel is skin within this many times the skin's median colour spread
+  double min_skin_distance = 12;      // ... and always within this colour distance
+
+  template <class V>
+  void visit(V& v) {
+    v("enabled", enabled, "Fit each eye's blink to how much of the open eye the photos show covered by skin.");
+    v("shapes", shapes,
+      "The expression shapes that close the eyes (one per eye; each is paired with the eye whose skin it moves "
+      "most).");
+    v("sigma", sigma, "Blink values outside the range that agrees with the photos cost ((distance) / sigma)^2.");
+    v("weight", weight, "Share of the energy of the eyelid term.");
+    v("tolerance", tolerance,
+      "The model's lid agrees with the photos when the fractions of the eye they cover differ by at most this.");
+    v("max_view_angle_deg", max_view_angle_deg,
+      "Cameras more than this many degrees from an eye's front are not used for it.");
+    v("sample_step", sample_step, "Every n-th eyeball vertex is tested for being seen or covered.");
+    v("min_samples", min_samples, "An eye seen at fewer eyeball points than this is left out of the frame.");
+    v("skin_distance_factor", skin_distance_factor,
+      "A pixel counts as skin when its colour lies within this many times the median colour spread of the skin "
+      "around the eye ...");
+    v("min_skin_distance", min_skin_distance,
+      "... or within this distance of its median colour (chromaticity in 8-bit levels, brightness 40 levels per "
+      "e-fold).");
+  }
+};
+
 // Priors on the blendshape coefficients and the pose.
 struct CoefficientOptions {
   double expression_sigma = 1.0;      // prior towards 0 (the neutral face)
@@ -149,6 +187,7 @@ struct Options {
   SurfaceTermOptions surface;
   FlowOptions flow;
   LandmarkOptions landmarks;
+  EyelidOptions eyelids;
   CoefficientOptions coefficients;
   CorrectionOptions corrections;
   int icp_iterations = 5;
@@ -169,6 +208,7 @@ struct Options {
     v("surface", surface, "The surface (non-rigid ICP) term.");
     v("flow", flow, "The optical-flow term.");
     v("landmarks", landmarks, "The 2D landmark term.");
+    v("eyelids", eyelids, "The eyelid term: blinks seen in the photos.");
     v("coefficients", coefficients, "Priors on the coefficients and the pose.");
     v("corrections", corrections, "Per-vertex corrections.");
     v("icp_iterations", icp_iterations, "Correspondence updates while fitting pose and coefficients.");

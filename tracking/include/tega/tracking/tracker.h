@@ -7,8 +7,10 @@
 // detail), expression coefficients b in [0, 1], per-vertex corrections c on
 // the skin and the head pose (R, t) = head_to_world.
 
+#include <map>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "tega/core/camera.h"
@@ -21,10 +23,15 @@ namespace tega::tracking {
 
 class LandmarkDetector;
 class SurfaceQuery;
+struct ModelEyes;
 
 struct SubjectIdentity {
   std::vector<double> coefficients;  // one per identity shape of the model
   Vertices neutral;                  // head space
+  // Per blink shape: the fraction of the open eye that the identity frames'
+  // photos show as skin (lashes, the lid's rim, pixels the model's aperture
+  // misses); the eyelid term measures closing from there.
+  std::map<std::string, double> open_eyes_covered;
 };
 
 struct HeadState {
@@ -41,6 +48,9 @@ struct FrameResiduals {
   int landmark_count = 0;
   double flow_rms_px = -1;                        // -1: no flow
   int flow_count = 0;
+  // Per blink shape: the fraction of the open eye the photos show covered
+  // by skin (eyes the cameras did not see are absent).
+  std::map<std::string, double> eyelids_covered;
 };
 
 // A frame's observations: its multi-view stereo mesh (world space) and,
@@ -53,7 +63,7 @@ struct FrameObservation {
 
 // Where a frame's time went, seconds.
 struct FrameTimings {
-  double image_terms_s = 0;   // optical flow and landmarks
+  double image_terms_s = 0;   // optical flow, landmarks and eyelids
   double coefficients_s = 0;  // pose and expression (correspondences included)
   double corrections_s = 0;   // per-vertex corrections (correspondences included)
 };
@@ -114,6 +124,7 @@ class TakeTracker {
   Options options_;
   const LandmarkDetector* landmarks_;
   std::vector<std::pair<int, int>> fit_edges_;
+  std::unique_ptr<ModelEyes> eyes_;  // null: no eyelid term
   std::unique_ptr<Previous> previous_;
 };
 
