@@ -210,15 +210,15 @@ std::vector<EyelidObservation> observe_eyelids(const ModelEyes& eyes, const Head
           std::max(options.min_skin_distance, options.skin_distance_factor * median_of(spread));
 
       // The eyeball points that face this camera ...
-      std::vector<Eigen::Vector3d> points;
-      std::vector<Eigen::Vector2d> pixels;
+      std::vector<Eigen::Vector3d> points, colours;
       for (int v : eye.eyeball_samples) {
         const Eigen::Vector3d p = row3(world, v);
         if ((p - centre).normalized().dot((eye_point - p).normalized()) < kMinFacingCosine) continue;
         const auto pixel = cameras[c].project(p);
-        if (!pixel || !colour_at(images[c], *pixel)) continue;
+        const auto colour = pixel ? colour_at(images[c], *pixel) : std::nullopt;
+        if (!colour) continue;
         points.push_back(p);
-        pixels.push_back(*pixel);
+        colours.push_back(colour_feature(*colour));
       }
       // ... and of them those the open lid leaves in sight.
       const std::vector<bool> hidden_open = lids[0]->occluded(eye_point, points, kOcclusionMarginM);
@@ -226,7 +226,7 @@ std::vector<EyelidObservation> observe_eyelids(const ModelEyes& eyes, const Head
       for (size_t i = 0; i < points.size(); ++i) {
         if (hidden_open[i]) continue;
         open_points.push_back(points[i]);
-        skin_seen += (colour_feature(*colour_at(images[c], pixels[i])) - skin_colour).norm() <= skin_distance;
+        skin_seen += (colours[i] - skin_colour).norm() <= skin_distance;
       }
       o.samples += int(open_points.size());
       for (int step = 1; step <= kBlinkSteps; ++step) {

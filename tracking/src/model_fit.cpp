@@ -170,16 +170,15 @@ class DeviationCost final : public ceres::CostFunction {
 class RangeCost : public ceres::CostFunction {
  public:
   RangeCost(long count, const CoefficientRange& range, double sigma)
-      : k_(range.coefficient), low_(range.low), high_(range.high), inverse_sigma_(1 / sigma) {
+      : count_(count), k_(range.coefficient), low_(range.low), high_(range.high), inverse_sigma_(1 / sigma) {
     set_num_residuals(1);
     mutable_parameter_block_sizes()->push_back(static_cast<int32_t>(count));
-    count_ = count;
   }
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
     const double s = parameters[0][k_];
     const double slope = s < low_ ? -1 : s > high_ ? 1 : 0;
-    residuals[0] = inverse_sigma_ * (s < low_ ? low_ - s : s > high_ ? s - high_ : 0);
+    residuals[0] = inverse_sigma_ * slope * (s - (s < low_ ? low_ : high_));
     if (jacobians && jacobians[0]) {
       std::fill(jacobians[0], jacobians[0] + count_, 0.0);
       jacobians[0][k_] = inverse_sigma_ * slope;
@@ -188,7 +187,7 @@ class RangeCost : public ceres::CostFunction {
   }
 
  private:
-  long count_ = 0;
+  long count_;
   int k_;
   double low_, high_, inverse_sigma_;
 };
