@@ -9,8 +9,10 @@
 
 #include "available_commands.h"
 #include "commands.h"
+#include "tega/core/error.h"
 #include "tega/pipeline/local_executor.h"
 #include "tega/pipeline/orchestrator.h"
+#include "tega/pipeline/slurm_executor.h"
 
 namespace tega::cli {
 namespace {
@@ -46,9 +48,24 @@ struct RunArguments {
   std::string config, workspace;
   std::vector<std::string> only, from, force;
   int jobs = 0;
+  std::string executor = "local";
+  pipeline::SlurmOptions slurm;
 };
 
-void run(const RunArguments& args, const CLI::App& root) {
+std::unique_ptr<pipeline::Executor> make_executor(const RunArguments& args, const CLI::App& cmd) {
+  if (args.executor == "slurm") {
+    if (cmd.count("--jobs") > 0) throw Error("--jobs applies to --executor local only (Slurm decides how many jobs run)");
+    return std::make_unique<pipeline::SlurmExecutor>(args.slurm);
+  }
+  for (const char* slurm_only : {"--partition", "--gpus-per-job", "--max-requeues"}) {
+    if (cmd.count(slurm_only) > 0) throw Error(std::string(slurm_only) + " applies to --executor slurm only");
+  }
+  const int jobs = args.jobs > 0 ? args.jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  return std::make_unique<pipeline::LocalExecutor>(jobs);
+}
+
+void run(const RunArguments& args, const CLI::App& cmd, const CLI::App& root) {
+  const std::unique_ptr<pipeline::Executor> executor = make_executor(args, cmd);
   pipeline::PipelineConfig config = pipeline::load_pipeline_config(args.config);
   if (!args.workspace.empty()) config.workspace = fs::absolute(args.workspace).lexically_normal();
   const pipeline::StageGraph graph(std::move(config),
@@ -61,10 +78,8 @@ void run(const RunArguments& args, const CLI::App& root) {
   request.tega_executable = fs::read_symlink("/proc/self/exe");
   request.tool_version = std::string("tega ") + TEGA_VERSION;
 
-  const int jobs = args.jobs > 0 ? args.jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  pipeline::LocalExecutor executor(jobs);
   const StopOnSignals stop_on_signals;
-  const pipeline::RunSummary summary = pipeline::run_pipeline(graph, request, executor, stop_requested);
+  const pipeline::RunSummary summary = pipeline::run_pipeline(graph, request, *executor, stop_requested);
 
   for (const auto& problem : summary.problems) std::cerr << "tega run: " << problem << "\n";
   std::cout << "tega run: " << summary.ran << " shard(s) ran, " << summary.up_to_date << " up to date, "
@@ -88,8 +103,19 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--jobs", args->jobs, "CPU shards run in parallel (default: one per hardware thread); "
                                         "GPU shards run one at a time per device.");
   cmd->add_option("--workspace", args->workspace, "Use this workspace instead of the config's.");
+  cmd->add_option("--executor", args->executor,
+                  "Where shards run: local (child processes) or slurm (a batch job each; the workspace must be on "
+                  "storage the compute nodes share; docs/pipeline.md#running-on-a-slurm-cluster).")
+      ->check(CLI::IsMember({"local", "slurm"}))
+      ->default_str("local");
+  cmd->add_option("--partition", args->slurm.partition, "Slurm partition for the jobs (default: the cluster's).");
+  cmd->add_option("--gpus-per-job", args->slurm.gpus_per_job, "GPUs a Slurm job of a GPU stage asks for (--gres=gpu:N).")
+      ->capture_default_str();
+  cmd->add_option("--max-requeues", args->slurm.max_requeues,
+                  "How often a Slurm job lost to the cluster (node failure, preemption, killed) is submitted again.")
+      ->capture_default_str();
   const CLI::App* root = &app;
-  cmd->callback([args, root] { run(*args, *root); });
+  cmd->callback([args, cmd, root] { run(*args, *cmd, *root); });
 }
 
 }  // namespace tega::cli

@@ -223,6 +223,15 @@ class Run {
     const Stage& stage = stage_of(s);
     const std::string& subject = subject_of(s);
     const fs::path log = ws_.log_file(stage.name(), subject);
+    if (result.requeue) {
+      spdlog::warn("{}: {}", s.id, result.failure);
+      try {
+        launch(s);
+      } catch (const std::exception& e) {
+        fail(s, std::string("could not be started again: ") + e.what());
+      }
+      return;
+    }
     if (!result.succeeded) {
       fail(s, result.failure + ": " + last_error_line(log) + " (log: " + log.string() + ")");
       return;

@@ -10,6 +10,7 @@
 #include "tega/core/error.h"
 #include "tega/core/progress.h"
 #include "tega/pipeline/manifest.h"
+#include "tega/pipeline/slurm_batch.h"
 #include "tega/pipeline/workspace.h"
 
 namespace tega::pipeline {
@@ -38,6 +39,17 @@ std::string dataset_gaps(const fs::path& dataset) {
   } catch (const Error&) {
     return "";
   }
+}
+
+// "slurm job 1234 RUNNING" from the record a Slurm run keeps beside the log. A record older than
+// the shard's state record was left by an earlier run that was killed, not written for this one.
+std::string cluster_job(const fs::path& record_file, const fs::path& state_file) {
+  std::error_code record_error, state_error;
+  const auto record_time = fs::last_write_time(record_file, record_error);
+  const auto state_time = fs::last_write_time(state_file, state_error);
+  if (record_error || state_error || record_time < state_time) return "";
+  const auto job = read_slurm_job_record(record_file);
+  return job ? "slurm job " + job->job_id + " " + job->state : "";
 }
 
 ShardStatus shard_status(const StageGraph& graph, size_t stage_index, size_t subject_index, const Workspace& ws,
@@ -70,6 +82,7 @@ ShardStatus shard_status(const StageGraph& graph, size_t stage_index, size_t sub
   if (state && state->state == "running" && active) {
     st.state = "running";
     st.log = state->log;
+    st.cluster_job = cluster_job(slurm_job_files(state->log).record, ws.state_file(stage.name(), subject));
     return st;
   }
   if (state && state->state == "failed") {
@@ -161,6 +174,7 @@ std::string status_text(const WorkspaceStatus& status) {
       out << "  " << shard.shard << "  " << shard.state;
       if (shard.state == "done") out << "  " << shard.finished << "  " << Progress::format_duration(shard.seconds);
       if (!shard.reason.empty() && stage.available) out << "  " << shard.reason;
+      if (!shard.cluster_job.empty()) out << "  " << shard.cluster_job;
       if (shard.state == "interrupted" || shard.state == "running") {
         out << "  log: " << shard.log;
       }
@@ -188,7 +202,8 @@ std::string status_json(const WorkspaceStatus& status) {
                         {"log", shard.log},
                         {"finished", shard.finished},
                         {"seconds", shard.seconds},
-                        {"dataset_gaps", shard.dataset_gaps}});
+                        {"dataset_gaps", shard.dataset_gaps},
+                        {"cluster_job", shard.cluster_job}});
     }
     stages.push_back({{"stage", stage.name},
                       {"kind", stage.kind},

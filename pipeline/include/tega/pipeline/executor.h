@@ -1,8 +1,8 @@
 #pragma once
 // Executors run shard commands; the orchestrator decides what runs and
 // commits the results. A job is a command line, a log file and the resources
-// it needs, so a cluster executor (Slurm: one sbatch per job, polled through
-// sacct) can run the very same jobs without any stage changing.
+// it needs, so a cluster executor (SlurmExecutor: one sbatch per job, polled
+// through squeue) runs the very same jobs without any stage changing.
 
 #include <chrono>
 #include <filesystem>
@@ -30,6 +30,10 @@ struct JobResult {
   bool succeeded = false;
   std::string failure;  // "exit code 1", "killed by signal 9", "could not start: ..."
   double seconds = 0;
+  // The job was lost to its cluster (node failure, preemption, its process killed), not failed by
+  // its command, and may be tried again: the orchestrator prepares its shard afresh (a killed
+  // attempt leaves a partial staging directory) and submits it again under the same id.
+  bool requeue = false;
 };
 
 class Executor {

@@ -24,6 +24,8 @@ struct ShardStatus {
   // A done shard that provides a dataset: the images and frames its producer
   // left out (dataset_gap_summary); empty when there are none.
   std::string dataset_gaps;
+  // A running shard of a Slurm run: "slurm job 1234 PENDING" (as of the run's last squeue poll).
+  std::string cluster_job;
 };
 
 struct StageStatus {

@@ -1,0 +1,335 @@
+#include "tega/pipeline/slurm_executor.h"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <spdlog/spdlog.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "tega/core/error.h"
+#include "tega/core/files.h"
+#include "tega/pipeline/slurm_batch.h"
+
+extern char** environ;
+
+namespace tega::pipeline {
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+struct ProgramResult {
+  int exit_code = -1;  // -1: it could not be started or a signal ended it
+  std::string output;  // stdout and stderr together
+};
+
+// Runs a Slurm client command from an argument vector (no shell ever sees the job's strings), in a
+// process group of its own so that a terminal's Ctrl-C reaches only the orchestrator, which then
+// cancels the jobs.
+ProgramResult run_program(const std::vector<std::string>& args) {
+  ProgramResult result;
+  int pipe_fds[2];
+  if (::pipe2(pipe_fds, O_CLOEXEC) != 0) {
+    result.output = std::string("cannot create a pipe: ") + std::strerror(errno);
+    return result;
+  }
+  std::vector<char*> argv;
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], STDOUT_FILENO);
+  posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], STDERR_FILENO);
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
+  posix_spawnattr_setpgroup(&attributes, 0);
+  pid_t pid = -1;
+  const int error = ::posix_spawn(&pid, argv[0], &actions, &attributes, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  posix_spawnattr_destroy(&attributes);
+  ::close(pipe_fds[1]);
+  if (error != 0) {
+    ::close(pipe_fds[0]);
+    result.output = args[0] + ": cannot be started: " + std::strerror(error);
+    return result;
+  }
+  char buffer[4096];
+  for (;;) {
+    const ssize_t n = ::read(pipe_fds[0], buffer, sizeof buffer);
+    if (n > 0) result.output.append(buffer, static_cast<size_t>(n));
+    if (n == 0 || (n < 0 && errno != EINTR)) break;
+  }
+  ::close(pipe_fds[0]);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+std::string last_line(const std::string& text) {
+  const auto end = text.find_last_not_of("\n");
+  if (end == std::string::npos) return "(no output)";
+  const auto start = text.rfind('\n', end);
+  return text.substr(start == std::string::npos ? 0 : start + 1, end - (start == std::string::npos ? 0 : start + 1) + 1);
+}
+
+fs::path find_tool(const fs::path& bin_dir, const std::string& name) {
+  if (!bin_dir.empty()) {
+    if (::access((bin_dir / name).c_str(), X_OK) == 0) return bin_dir / name;
+    throw Error(bin_dir / name, "is not an executable; the Slurm executor needs Slurm's client commands there");
+  }
+  const char* path = std::getenv("PATH");
+  std::istringstream dirs(path ? path : "");
+  for (std::string dir; std::getline(dirs, dir, ':');) {
+    if (!dir.empty() && ::access((fs::path(dir) / name).c_str(), X_OK) == 0) return fs::path(dir) / name;
+  }
+  throw Error(name + " was not found on PATH: the Slurm executor needs Slurm's client commands (sbatch, squeue, "
+              "scancel; Debian: slurm-client) on this host");
+}
+
+// Slurm's job states that end a job (squeue --states=all keeps showing them for MinJobAge).
+bool is_final(const std::string& state) {
+  static const std::set<std::string> final_states = {"COMPLETED", "FAILED",   "CANCELLED",     "TIMEOUT",
+                                                     "NODE_FAIL", "PREEMPTED", "BOOT_FAIL",    "OUT_OF_MEMORY",
+                                                     "DEADLINE",  "REVOKED",   "SPECIAL_EXIT"};
+  return final_states.count(state) > 0;
+}
+
+// Final states that another attempt would reach again, or that someone chose: not requeued.
+bool is_deliberate_end(const std::string& state) {
+  return state == "CANCELLED" || state == "TIMEOUT" || state == "OUT_OF_MEMORY" || state == "DEADLINE";
+}
+
+std::optional<int> read_exit_status(const fs::path& exit_file) {
+  if (!fs::exists(exit_file)) return std::nullopt;
+  try {
+    return std::stoi(read_text_file(exit_file));
+  } catch (const std::exception&) {
+    return std::nullopt;  // written with tmp + mv, so never partial; unreadable means absent
+  }
+}
+
+// In a job, CUDA_VISIBLE_DEVICES lists only its allocated GPUs, numbered from 0.
+void check_gpu_device(const Job& job, int gpus_per_job) {
+  const std::string& device = job.resources.gpu_device;
+  const auto colon = device.find(':');
+  if (colon == std::string::npos) return;
+  int index = 0;
+  try {
+    index = std::stoi(device.substr(colon + 1));
+  } catch (const std::exception&) {
+    throw Error(job.id + ": device '" + device + "' has no GPU index after the colon");
+  }
+  if (index >= gpus_per_job) {
+    throw Error(job.id + ": device '" + device + "' names GPU " + std::to_string(index) + " of its Slurm job, which has " +
+                std::to_string(gpus_per_job) + " (--gpus-per-job); under Slurm use 'cuda' or 'cuda:0'");
+  }
+}
+
+// sbatch reads %j, %u, ... in --output; %% is a literal %.
+std::string slurm_filename(const fs::path& file) {
+  std::string out;
+  for (const char c : file.string()) out += c == '%' ? std::string("%%") : std::string(1, c);
+  return out;
+}
+
+}  // namespace
+
+SlurmExecutor::SlurmExecutor(SlurmOptions options)
+    : options_(std::move(options)),
+      sbatch_(find_tool(options_.bin_dir, "sbatch")),
+      squeue_(find_tool(options_.bin_dir, "squeue")),
+      scancel_(find_tool(options_.bin_dir, "scancel")) {
+  if (options_.gpus_per_job < 1) throw Error("--gpus-per-job must be at least 1 (it is " + std::to_string(options_.gpus_per_job) + ")");
+  if (options_.max_requeues < 0) throw Error("--max-requeues must not be negative (it is " + std::to_string(options_.max_requeues) + ")");
+}
+
+SlurmExecutor::~SlurmExecutor() {
+  try {
+    cancel_all();
+  } catch (const std::exception& e) {
+    spdlog::error("tega run: could not cancel the Slurm jobs: {}", e.what());
+  }
+}
+
+void SlurmExecutor::submit(Job job) { queue_.push_back(std::move(job)); }
+
+std::string SlurmExecutor::sbatch(const Job& job) const {
+  check_gpu_device(job, options_.gpus_per_job);
+  fs::create_directories(job.log_file.parent_path());
+  const SlurmJobFiles files = slurm_job_files(job.log_file);
+  fs::remove(files.exit_file);
+  write_text_atomic(files.script, batch_script(job, files.exit_file));
+
+  std::vector<std::string> args = {sbatch_.string(),
+                                   "--parsable",
+                                   "--job-name=" + options_.job_name_prefix + job.id,
+                                   "--output=" + slurm_filename(job.log_file),
+                                   "--error=" + slurm_filename(job.log_file),
+                                   "--open-mode=append",
+                                   "--export=ALL",
+                                   "--no-requeue"};  // requeues are ours: the shard is prepared afresh first
+  if (!options_.partition.empty()) args.push_back("--partition=" + options_.partition);
+  if (!job.resources.gpu_device.empty()) args.push_back("--gres=gpu:" + std::to_string(options_.gpus_per_job));
+  args.push_back(files.script.string());
+  const ProgramResult result = run_program(args);
+  // --parsable prints "<id>" or "<id>;<cluster>".
+  const std::string id = result.output.substr(0, result.output.find_first_of(";\n"));
+  if (result.exit_code != 0 || id.empty() || id.find_first_not_of("0123456789") != std::string::npos) {
+    throw Error("sbatch failed for " + job.id + ": " + last_line(result.output));
+  }
+  write_slurm_job_record(files.record, {id, "PENDING"});
+  return id;
+}
+
+void SlurmExecutor::submit_queued(std::vector<JobResult>& results) {
+  for (; !queue_.empty(); queue_.pop_front()) {
+    Job& job = queue_.front();
+    try {
+      const std::string slurm_id = sbatch(job);
+      spdlog::info("{}: Slurm job {}", job.id, slurm_id);
+      submitted_[slurm_id] = {std::move(job), "PENDING", Clock::now(), std::nullopt};
+    } catch (const std::exception& e) {
+      results.push_back({job.id, false, std::string("could not start: ") + e.what(), 0, false});
+    }
+  }
+}
+
+std::optional<std::map<std::string, std::string>> SlurmExecutor::queue_states() const {
+  std::string ids;
+  for (const auto& [slurm_id, job] : submitted_) ids += (ids.empty() ? "" : ",") + slurm_id;
+  const ProgramResult result =
+      run_program({squeue_.string(), "--noheader", "--states=all", "--format=%i|%T", "--jobs=" + ids});
+  std::map<std::string, std::string> states;
+  if (result.exit_code != 0) {
+    // squeue fails outright when it knows none of the ids: every job is long over.
+    if (result.output.find("Invalid job id") != std::string::npos) return states;
+    spdlog::warn("tega run: squeue failed (will ask again): {}", last_line(result.output));
+    return std::nullopt;
+  }
+  std::istringstream lines(result.output);
+  for (std::string line; std::getline(lines, line);) {
+    const auto bar = line.find('|');
+    if (bar != std::string::npos) states[line.substr(0, bar)] = line.substr(bar + 1);
+  }
+  return states;
+}
+
+void SlurmExecutor::poll(std::vector<JobResult>& results) {
+  const auto states = queue_states();
+  if (!states) return;
+  for (auto it = submitted_.begin(); it != submitted_.end();) {
+    Submitted& job = it->second;
+    const auto state = states->find(it->first);
+    // A job squeue no longer knows ended long enough ago to be purged.
+    const std::string now = state == states->end() ? "GONE" : state->second;
+    if (now != job.state && !is_final(now) && now != "GONE") {
+      write_slurm_job_record(slurm_job_files(job.job.log_file).record, {it->first, now});
+    }
+    job.state = now;
+    if ((is_final(now) || now == "GONE") && conclude(job, it->first, results)) {
+      fs::remove(slurm_job_files(job.job.log_file).record);
+      it = submitted_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+}
+
+bool SlurmExecutor::conclude(Submitted& job, const std::string& slurm_id, std::vector<JobResult>& results) {
+  const auto status = read_exit_status(slurm_job_files(job.job.log_file).exit_file);
+  if (!status) {
+    if (!job.over_without_exit_file) job.over_without_exit_file = Clock::now();
+    if (Clock::now() - *job.over_without_exit_file < options_.exit_file_grace) return false;
+  }
+  const double seconds = std::chrono::duration<double>(Clock::now() - job.submitted).count();
+  const std::string slurm = "Slurm job " + slurm_id + " (" + job.state + ")";
+  if (status && *status <= 128) {
+    results.push_back({job.job.id, *status == 0, *status == 0 ? "" : "exit code " + std::to_string(*status), seconds, false});
+  } else if (is_deliberate_end(job.state)) {
+    results.push_back({job.job.id, false, slurm + " ended it", seconds, false});
+  } else if (status) {
+    results.push_back(lost(job, slurm + ": its command was killed by signal " + std::to_string(*status - 128)));
+  } else {
+    results.push_back(lost(job, slurm + " ended without the command's exit status"));
+  }
+  return true;
+}
+
+JobResult SlurmExecutor::lost(const Submitted& job, const std::string& why) {
+  const double seconds = std::chrono::duration<double>(Clock::now() - job.submitted).count();
+  const int requeues = requeues_[job.job.id]++;
+  if (requeues < options_.max_requeues) {
+    return {job.job.id, false,
+            why + "; submitting it again (requeue " + std::to_string(requeues + 1) + " of " +
+                std::to_string(options_.max_requeues) + ")",
+            seconds, true};
+  }
+  return {job.job.id, false, why + "; lost " + std::to_string(requeues + 1) + " times, not submitted again (--max-requeues " +
+                                 std::to_string(options_.max_requeues) + ")",
+          seconds, false};
+}
+
+std::vector<JobResult> SlurmExecutor::wait(std::chrono::milliseconds timeout) {
+  std::vector<JobResult> results;
+  const auto deadline = Clock::now() + timeout;
+  submit_queued(results);
+  while (results.empty() && !submitted_.empty()) {
+    if (Clock::now() >= next_poll_) {
+      poll(results);
+      next_poll_ = Clock::now() + options_.poll_interval;
+    }
+    if (!results.empty() || Clock::now() >= deadline) break;
+    std::this_thread::sleep_until(std::min(deadline, next_poll_));
+  }
+  return results;
+}
+
+void SlurmExecutor::cancel_all() {
+  queue_.clear();
+  if (submitted_.empty()) return;
+  std::vector<std::string> args = {scancel_.string()};
+  for (const auto& [slurm_id, job] : submitted_) args.push_back(slurm_id);
+  if (const ProgramResult result = run_program(args); result.exit_code != 0)
+    spdlog::warn("tega run: scancel failed: {}", last_line(result.output));
+  const auto deadline = Clock::now() + options_.cancel_timeout;
+  for (;;) {
+    bool any_left = true;  // until squeue says otherwise
+    if (const auto states = queue_states()) {
+      any_left = false;
+      for (const auto& [slurm_id, job] : submitted_) {
+        const auto state = states->find(slurm_id);
+        any_left = any_left || (state != states->end() && !is_final(state->second));
+      }
+    }
+    if (!any_left) break;
+    if (Clock::now() >= deadline) {
+      spdlog::warn("tega run: Slurm still reports cancelled jobs unfinished after {} s", options_.cancel_timeout.count() / 1000);
+      break;
+    }
+    std::this_thread::sleep_for(std::min(options_.poll_interval, std::chrono::milliseconds(500)));
+  }
+  for (const auto& [slurm_id, job] : submitted_) fs::remove(slurm_job_files(job.job.log_file).record);
+  submitted_.clear();
+}
+
+std::vector<std::string> SlurmExecutor::running() const {
+  std::vector<std::string> ids;
+  for (const auto& [slurm_id, job] : submitted_) {
+    if (job.state == "RUNNING") ids.push_back(job.job.id);
+  }
+  return ids;
+}
+
+}  // namespace tega::pipeline
