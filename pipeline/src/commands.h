@@ -20,4 +20,5 @@ void add_eval_command(CLI::App& app);
 void add_export_command(CLI::App& app);
 void add_run_command(CLI::App& app);
 void add_status_command(CLI::App& app);
+void add_report_command(CLI::App& app);
 }  // namespace tega::cli

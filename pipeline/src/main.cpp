@@ -49,6 +49,9 @@ int main(int argc, char** argv) {
 #endif
   tega::cli::add_run_command(app);
   tega::cli::add_status_command(app);
+#ifdef TEGA_HAVE_REPORT
+  tega::cli::add_report_command(app);
+#endif
 
   try {
     app.parse(argc, argv);

@@ -1,0 +1,51 @@
+#include "report_context.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "tega/core/error.h"
+
+namespace tega::report {
+namespace fs = std::filesystem;
+
+std::string ReportContext::link(const fs::path& file) const {
+  return fs::absolute(file)
+      .lexically_normal()
+      .lexically_relative(fs::absolute(page_dir).lexically_normal())
+      .generic_string();
+}
+
+void ReportContext::add_figure(Section& section, std::string file, Image8 image, std::string caption) {
+  section.image(file, std::move(caption));
+  figures.push_back({std::move(file), std::move(image)});
+}
+
+std::string fixed(double value, int decimals) {
+  if (std::isnan(value)) return "nan";
+  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*f", decimals, value);
+  return text;
+}
+
+std::string verdict(bool met) { return met ? "met" : "missed"; }
+
+std::vector<size_t> spread(size_t n, size_t count) {
+  std::vector<size_t> out;
+  if (n == 0 || count == 0) return out;
+  if (count >= n) {
+    for (size_t i = 0; i < n; ++i) out.push_back(i);
+    return out;
+  }
+  if (count == 1) return {n / 2};
+  for (size_t k = 0; k < count; ++k) out.push_back(k * (n - 1) / (count - 1));
+  return out;
+}
+
+const fs::path& artifact(const StageOutput& stage, const std::string& name) {
+  const auto it = stage.artifacts.find(name);
+  if (it == stage.artifacts.end()) throw Error("stage " + stage.stage + " (" + stage.kind + ") provides no " + name);
+  return it->second;
+}
+
+}  // namespace tega::report
