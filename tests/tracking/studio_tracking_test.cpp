@@ -215,6 +215,14 @@ TEST(StudioTracking, TracksTegasOwnMeshesWithinTheTargets) {
   const auto summary_json = nlohmann::json::parse(read_text_file(dir / "tracked_with_gap" / "expressions" / "track.json"));
   EXPECT_EQ(summary_json["frames_not_tracked"].size(), 1u);
 
+  // No scan at all: every frame is recorded as skipped and the take fails.
+  fs::create_directories(dir / "no_meshes" / "expressions");
+  const std::string none =
+      test::error_message([&] { track_capture({capture, {}, dir / "no_meshes", dir / "tracked_none", {}}, reuse); });
+  EXPECT_NE(none.find("no frame of take expressions was tracked (frame 0 skipped"), std::string::npos) << none;
+  EXPECT_TRUE(fs::exists(dir / "tracked_none" / "expressions" / "000000.json"));
+  EXPECT_FALSE(fs::exists(dir / "tracked_none" / "expressions" / "track.json"));
+
   reuse.landmarks.ignored_points = {36, 68};
   const std::string bad_point =
       test::error_message([&] { track_capture({capture, {}, dir / "true_meshes", dir / "tracked_bad", {}}, reuse); });

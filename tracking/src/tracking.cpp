@@ -153,6 +153,11 @@ void track_take(const TakeContext& t, const Options& options, TrackSummary& summ
   summary_json["frames_not_tracked"] = nlohmann::json::array();
   for (const auto& r : records)
     if (r.status != "tracked") summary_json["frames_not_tracked"].push_back({{"frame", r.frame}, {"status", r.status}, {"reason", r.reason}});
+  // A take without a single tracked frame is no track; the frames' records
+  // stay, and with no track.json a rerun fails the same way.
+  if (tracked == 0 && !records.empty())
+    throw Error(t.out, "no frame of take " + t.take.name + " was tracked (frame " + std::to_string(records.front().frame) +
+                           " " + records.front().status + ": " + records.front().reason + "); see the frame records there");
   write_text_atomic(t.out / "track.json", summary_json.dump(2) + "\n");
 }
 
