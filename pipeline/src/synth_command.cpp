@@ -17,7 +17,7 @@ struct SynthArgs {
   std::string out, config, head;
   int cameras = 0, frames = 0, width = 0, height = 0, threads = 0;
   int64_t seed = 0;
-  bool print_options = false, force = false;
+  bool print_options = false, force = false, truth_apart = false;
   CLI::Option *cameras_opt, *frames_opt, *width_opt, *height_opt, *seed_opt, *head_opt, *threads_opt;
 };
 
@@ -31,6 +31,7 @@ synth::Options resolve_options(const SynthArgs& a) {
   if (a.seed_opt->count()) o.seed = a.seed;
   if (a.head_opt->count()) o.head = a.head;
   if (a.threads_opt->count()) o.threads = a.threads;
+  if (a.truth_apart) o.truth_apart = true;
   return o;
 }
 
@@ -42,15 +43,17 @@ void run(const SynthArgs& a) {
   }
   if (a.out.empty()) throw Error("tega synth: --out DIR is required");
   const synth::SynthSummary s = synth::render_virtual_studio(options, a.out, a.force);
+  // With truth_apart the rig, ground truth and dataset lie beside the capture.
+  const std::string truth = options.truth_apart ? synth::truth_directory(s.root).string() + "/" : std::string();
   std::cout << "wrote " << s.root.string() << " in " << Progress::format_duration(s.seconds) << "\n"
             << "  head:     " << s.head << "\n"
-            << "  cameras:  " << s.cameras << " at " << s.width << "x" << s.height << " (rig.json)\n";
+            << "  cameras:  " << s.cameras << " at " << s.width << "x" << s.height << " (" << truth << "rig.json)\n";
   for (const auto& t : s.takes)
     std::cout << "  take:     " << t.name << " (" << t.kind << ", " << t.frames << " frames)  takes/" << t.name << "/\n";
   if (s.calibration_skipped) std::cout << "  take:     calibration skipped (this build has no OpenCV)\n";
   std::cout << "  images:   " << s.images << "\n"
-            << "  truth:    ground_truth/ (meshes, alpha, poses, expressions)\n"
-            << "  dataset:  dataset/ (" << s.dataset_frames << " frames)\n";
+            << "  truth:    " << truth << "ground_truth/ (meshes, alpha, poses, expressions)\n"
+            << "  dataset:  " << truth << "dataset/ (" << s.dataset_frames << " frames)\n";
 }
 
 }  // namespace
@@ -71,6 +74,8 @@ void add_synth_command(CLI::App& app) {
   cmd->add_option("--config", args->config, "YAML file of synth options (see --print-options); flags override it.");
   cmd->add_flag("--print-options", args->print_options, "Print the resolved options as documented YAML and exit.");
   cmd->add_flag("--force", args->force, "Replace an existing output directory.");
+  cmd->add_flag("--truth-apart", args->truth_apart,
+                "A raw capture in --out (capture.json and takes/); its rig, ground truth and dataset in OUT.truth/.");
   cmd->callback([args] { run(*args); });
 }
 

@@ -100,7 +100,7 @@ Section calibration_section(const StageOutput& stage, ReportContext& context) {
   }
   if (context.scoring()) {
     try {
-      score_rig(stage.stage, read_rig_json(rig_file), read_rig_json(context.subject.capture / "rig.json"), rig_file,
+      score_rig(stage.stage, read_rig_json(rig_file), read_rig_json(context.subject.truth / "rig.json"), rig_file,
                 section, context);
     } catch (const std::exception& e) {
       context.score_errors.push_back(stage.stage + ": " + e.what());

@@ -61,7 +61,7 @@ double coverage(const std::vector<fs::path>& mattes) {
 void score_take(const std::string& stage_name, const fs::path& mattes, const std::string& take, Section& section,
                 ReportContext& context) {
   logging::info("report: scoring the mattes of take %s against the studio's alpha", take.c_str());
-  const matting::MatteScores s = matting::score_mattes(mattes, context.subject.capture, take);
+  const matting::MatteScores s = matting::score_mattes(mattes, context.subject.truth, take);
   Table table{{"measure", "mean", "worst image", "target"}, {}};
   const std::string stage = stage_name + " (" + take + ")";
   table.rows.push_back({"|alpha error|", fixed(s.mean_error, 4), fixed(s.worst_mean_error, 4), "<= 0.02 per image"});

@@ -77,7 +77,7 @@ RigidTransform mesh_to_truth_world(const SubjectOutputs& subject) {
   const StageOutput* calibrate = subject.first_of_kind("calibrate");
   if (!calibrate || !calibrate->committed) return {};  // the capture's own rig: the truth's world
   const Rig calibrated = read_rig_json(artifact(*calibrate, "rig"));
-  const Rig truth = read_rig_json(subject.capture / "rig.json");
+  const Rig truth = read_rig_json(subject.truth / "rig.json");
   if (calibrated.cameras.empty() || truth.cameras.empty()) throw Error(artifact(*calibrate, "rig"), "has no cameras");
   return truth.cameras[0].world_to_camera.inverse() * calibrated.cameras[0].world_to_camera;
 }
@@ -105,7 +105,7 @@ void score_meshes(const std::string& stage, const fs::path& meshes,
       const int frame = records[i].frame;
       char name[16];
       std::snprintf(name, sizeof name, "%06d.ply", frame);
-      const mvs::StudioTruth truth = mvs::load_studio_truth(context.subject.capture, take, frame);
+      const mvs::StudioTruth truth = mvs::load_studio_truth(context.subject.truth, take, frame);
       Mesh mesh = read_mesh(meshes / take / name);
       for (int v = 0; v < mesh.positions.rows(); ++v)
         mesh.positions.row(v) =

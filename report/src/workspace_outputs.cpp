@@ -19,7 +19,7 @@ const StageOutput* SubjectOutputs::first_of_kind(const std::string& kind) const 
 
 bool SubjectOutputs::virtual_studio() const {
   std::error_code ignored;
-  return !capture.empty() && fs::is_directory(capture / "ground_truth", ignored);
+  return !truth.empty() && fs::is_directory(truth / "ground_truth", ignored);
 }
 
 std::vector<SubjectOutputs> workspace_outputs(const fs::path& workspace, const std::vector<std::string>& subjects,
@@ -52,8 +52,10 @@ std::vector<SubjectOutputs> workspace_outputs(const fs::path& workspace, const s
       if (const auto capture = o.artifacts.find("capture");
           capture != o.artifacts.end() && outputs.capture == subject.capture)
         outputs.capture = capture->second;
+      if (const auto truth = o.artifacts.find("truth"); truth != o.artifacts.end()) outputs.truth = truth->second;
       outputs.stages.push_back(std::move(o));
     }
+    if (outputs.truth.empty()) outputs.truth = outputs.capture;
     out.push_back(std::move(outputs));
   }
   return out;

@@ -24,9 +24,13 @@ struct SubjectOutputs {
   // The subject's capture: a committed stage's `capture` artifact, else the
   // subject's configured capture; empty when there is none.
   std::filesystem::path capture;
+  // Where the virtual studio's truth lies (its rig.json and ground_truth/):
+  // a committed `truth` artifact (a synth_raw stage keeps it apart from the
+  // capture), else the capture itself.
+  std::filesystem::path truth;
 
   const StageOutput* first_of_kind(const std::string& kind) const;  // nullptr when the config has none
-  bool virtual_studio() const;                                      // the capture has the studio's ground_truth/
+  bool virtual_studio() const;                                      // `truth` has the studio's ground_truth/
 };
 
 // Throws tega::Error when the workspace has no recorded config or a subject is unknown.

@@ -90,8 +90,8 @@ void render_calibration(const Studio& studio, const std::string& take) {
                                          "corner id = y * (squares_x - 1) + x at ((x + 1), (y + 1)) * square_m"}}},
                        {"frames", nlohmann::json::array()}};
   for (int f = 0; f < frames; ++f) gt["frames"].push_back({{"index", f}, {"board_to_world", pose_json(poses[f])}});
-  std::filesystem::create_directories(studio.root / "ground_truth" / take);
-  write_text_atomic(studio.root / "ground_truth" / take / "frames.json", gt.dump(2) + "\n");
+  std::filesystem::create_directories(studio.truth / "ground_truth" / take);
+  write_text_atomic(studio.truth / "ground_truth" / take / "frames.json", gt.dump(2) + "\n");
   write_take_json(studio, take, "calibration", frames);
 }
 

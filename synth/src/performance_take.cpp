@@ -38,7 +38,7 @@ void render_performance(const Studio& studio, const std::string& take, const Dat
 
   const auto& cameras = studio.rig.cameras;
   const int n_cameras = static_cast<int>(cameras.size());
-  const std::filesystem::path gt = studio.root / "ground_truth" / take;
+  const std::filesystem::path gt = studio.truth / "ground_truth" / take;
   std::filesystem::create_directories(gt / "coarse");
   if (o.write_fine_meshes) std::filesystem::create_directories(gt / "fine");
   for (const auto& cam : cameras) {

@@ -21,7 +21,8 @@ namespace tega::synth {
 
 struct Studio {
   const Options& options;
-  std::filesystem::path root;  // the staging directory
+  std::filesystem::path root;   // the capture's staging directory: takes/
+  std::filesystem::path truth;  // where ground_truth/ goes: `root`, or the truth's staging directory (truth_apart)
   const Head& head;
   const FineMeshMaker& maker;
   const Rig& rig;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 #include <set>
 
 #include "studio.h"
@@ -49,6 +50,12 @@ void write_head_ground_truth(const std::filesystem::path& dir, const Head& head,
 
 }  // namespace
 
+std::filesystem::path truth_directory(const std::filesystem::path& out) {
+  std::filesystem::path dir = out;
+  if (!dir.has_filename()) dir = dir.parent_path();  // "capture/" names capture
+  return dir.string() + ".truth";
+}
+
 void validate_options(const Options& o) {
   make_studio_rig(o.studio);  // throws for a bad studio
   if (o.frames < 1) throw Error("frames must be at least 1");
@@ -79,8 +86,12 @@ Head make_head(const Options& o) {
 SynthSummary render_virtual_studio(const Options& o, const std::filesystem::path& out, bool replace_existing) {
   const auto start = std::chrono::steady_clock::now();
   validate_options(o);
+  // The truth is committed before the capture, so a capture that exists always has its truth.
+  std::optional<StagedDirectory> staged_truth;
+  if (o.truth_apart) staged_truth.emplace(truth_directory(out), replace_existing);
   StagedDirectory staged(out, replace_existing);
   const std::filesystem::path root = staged.path();
+  const std::filesystem::path truth = staged_truth ? staged_truth->path() : root;
 
   const Head head = make_head(o);
   const FineMeshMaker maker(head, {o.fine_subdivisions, o.wrinkle_depth_m, o.crease_darkening});
@@ -107,10 +118,10 @@ SynthSummary render_virtual_studio(const Options& o, const std::filesystem::path
     backgrounds[c] = backdrop.render(rig.cameras[c]);
     lens[c] = pinhole_lookup(rig.cameras[c]);
   });
-  const Studio studio{o, root, head, maker, rig, appearance, shader, backgrounds, lens, pool, progress};
+  const Studio studio{o, root, truth, head, maker, rig, appearance, shader, backgrounds, lens, pool, progress};
 
-  write_rig_json(rig, root / "rig.json");
-  write_head_ground_truth(root / "ground_truth" / "head", head, maker);
+  write_rig_json(rig, truth / "rig.json");
+  write_head_ground_truth(truth / "ground_truth" / "head", head, maker);
 
   SynthSummary summary;
   summary.root = out;
@@ -128,7 +139,7 @@ SynthSummary render_virtual_studio(const Options& o, const std::filesystem::path
   }
 
   Dataset dataset;
-  dataset.root = root / "dataset";
+  dataset.root = truth / "dataset";
   dataset.rig = rig;
   for (Camera& cam : dataset.rig.cameras) cam.distortion = {};  // its images are undistorted
   dataset.template_mesh = head.model.neutral;
@@ -151,7 +162,7 @@ SynthSummary render_virtual_studio(const Options& o, const std::filesystem::path
 
   nlohmann::json takes = nlohmann::json::array();
   for (const auto& t : summary.takes) takes.push_back({{"name", t.name}, {"kind", t.kind}, {"frames", t.frames}});
-  const nlohmann::json capture = {
+  nlohmann::json capture = {
       {"format", "tega-capture"},
       {"version", 1},
       {"generator", std::string("tega synth ") + TEGA_VERSION},
@@ -162,11 +173,12 @@ SynthSummary render_virtual_studio(const Options& o, const std::filesystem::path
       {"height", o.studio.height},
       {"takes", takes},
       {"calibration_skipped", summary.calibration_skipped},
-      {"rig", "rig.json"},
-      {"ground_truth", "ground_truth"},
-      {"dataset", "dataset"},
       {"options", options_to_yaml(o)}};
+  // A raw capture names no rig: a stage that is not given the calibrated one
+  // fails on the missing rig.json instead of reading the truth.
+  if (!o.truth_apart) capture.update({{"rig", "rig.json"}, {"ground_truth", "ground_truth"}, {"dataset", "dataset"}});
   write_text_atomic(root / "capture.json", capture.dump(2) + "\n");
+  if (staged_truth) staged_truth->commit();
   staged.commit();
 
   summary.images = total;

@@ -27,6 +27,21 @@ std::vector<StageKind> make_stage_kinds() {
   synth.arguments = [](const ShardPaths& p) { return with_config({"--out", (p.output / "capture").string()}, p); };
   kinds.push_back(synth);
 
+  // The raw path's input (docs/pipeline.md#raw-frames-to-avatar): with
+  // --truth-apart `capture` holds only the takes and the truth (rig,
+  // ground_truth/, dataset/) lies beside it, where no stage that takes the
+  // capture looks. It provides no `dataset`: the raw path's comes from a
+  // `dataset` stage, never from the truth.
+  StageKind synth_raw = synth;
+  synth_raw.name = "synth_raw";
+  synth_raw.summary =
+      "virtual studio: a raw synthetic capture, its ground truth apart for tega report (tega synth, truth_apart)";
+  synth_raw.provides = {{"capture", "capture"}, {"truth", "capture.truth"}};
+  synth_raw.arguments = [](const ShardPaths& p) {
+    return with_config({"--out", (p.output / "capture").string(), "--truth-apart"}, p);
+  };
+  kinds.push_back(synth_raw);
+
   StageKind ingest;
   ingest.name = "ingest_multiface";
   ingest.summary = "a Multiface capture converted to a dataset (tega ingest multiface)";

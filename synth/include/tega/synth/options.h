@@ -61,6 +61,7 @@ struct Options {
   double crease_darkening = 0.5;
   double noise_sigma = 0.004;
   bool write_fine_meshes = true;
+  bool truth_apart = false;
   int threads = 0;
 
   template <class V>
@@ -97,6 +98,10 @@ struct Options {
     v("noise_sigma", noise_sigma, "Standard deviation of sensor noise, in [0, 1] intensity units.");
     v("write_fine_meshes", write_fine_meshes,
       "Write the fine (rendered) mesh of every frame into ground_truth/ (large for long takes).");
+    v("truth_apart", truth_apart,
+      "Write the ground truth (the true rig.json, ground_truth/ and dataset/) into the sibling directory "
+      "OUT.truth/ instead of into the capture OUT/, which then holds only what a capture session records "
+      "(capture.json and takes/, no rig): a raw capture whose later stages cannot read the truth.");
     v("threads", threads, "Worker threads; 0 = one per hardware thread.");
   }
 };

@@ -35,9 +35,15 @@ void validate_options(const Options& options);
 // The head the options ask for (procedural or loaded from options.head).
 Head make_head(const Options& options);
 
-// Renders everything into `out`, which appears complete or not at all
-// (tega::StagedDirectory). An existing `out` is replaced only when
-// `replace_existing`; otherwise it is an error naming it.
+// Where the ground truth of a capture rendered into `out` goes with
+// Options::truth_apart: the sibling `out`.truth.
+std::filesystem::path truth_directory(const std::filesystem::path& out);
+
+// Renders everything into `out` (and, with Options::truth_apart, the ground
+// truth into truth_directory(out)), each of which appears complete or not at
+// all (tega::StagedDirectory); the truth is committed first. An existing
+// `out` (or truth) is replaced only when `replace_existing`; otherwise it is
+// an error naming it.
 SynthSummary render_virtual_studio(const Options& options, const std::filesystem::path& out,
                                    bool replace_existing = false);
 
