@@ -136,7 +136,7 @@ TEST(StageGraph, TheDatasetTakesMattesOnlyWhereAMatteStageIsUpstream) {
 
 TEST(StageGraph, RejectsUnknownKindsCyclesAndMissingArtifacts) {
   EXPECT_NE(error_of([] { StageGraph(parse("workspace: ws\nstages: {x: {kind: sinth}}\n"), all_commands); })
-                .find("stage 'x': unknown kind 'sinth'; known kinds: synth, ingest_multiface, dataset_check"),
+                .find("stage 'x': unknown kind 'sinth'; known kinds: synth, synth_raw, ingest_multiface, dataset_check"),
             std::string::npos);
   EXPECT_NE(error_of([] {
               StageGraph(parse("workspace: ws\nstages: {a: {kind: synth, after: b}, b: {kind: synth, after: a}}\n"),
