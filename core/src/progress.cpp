@@ -7,10 +7,11 @@
 
 namespace tega {
 
-Progress::Progress(std::string label, int64_t total, std::string unit)
+Progress::Progress(std::string label, int64_t total, std::string unit, std::chrono::milliseconds log_interval)
     : label_(std::move(label)),
       unit_(std::move(unit)),
       total_(total),
+      log_interval_(log_interval),
       start_(std::chrono::steady_clock::now()),
       last_draw_(start_),
       tty_(::isatty(STDERR_FILENO) != 0) {}
@@ -33,10 +34,10 @@ std::string Progress::format_duration(double seconds) {
 
 void Progress::advance(int64_t n) {
   done_ += n;
-  if (!tty_) return;
   const auto now = std::chrono::steady_clock::now();
+  const auto interval = tty_ ? std::chrono::milliseconds(100) : log_interval_;
   std::unique_lock lock(mutex_, std::try_to_lock);
-  if (!lock.owns_lock() || finished_ || now - last_draw_ < std::chrono::milliseconds(100)) return;
+  if (!lock.owns_lock() || finished_ || now - last_draw_ < interval) return;
   last_draw_ = now;
   draw(false);
 }
@@ -53,7 +54,7 @@ void Progress::draw(bool final_line) {
   if (tty_) {
     std::fprintf(stderr, "\r\033[K%s%s", line.c_str(), final_line ? "\n" : "");
     std::fflush(stderr);
-  } else if (final_line) {
+  } else {
     spdlog::info("{}", line);
   }
 }

@@ -2,9 +2,14 @@
 
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <numeric>
+#include <unistd.h>
 
+#include <atomic>
+#include <chrono>
+#include <numeric>
+#include <thread>
+
+#include "tega/core/log.h"
 #include "tega/core/progress.h"
 
 namespace {
@@ -45,6 +50,27 @@ TEST(Progress, CountsFromManyThreadsAndFormatsDurations) {
   EXPECT_EQ(tega::Progress::format_duration(125), "2:05");
   EXPECT_EQ(tega::Progress::format_duration(3723), "1:02:03");
   EXPECT_EQ(tega::Progress::format_duration(-1), "--:--");
+}
+
+// Under ctest stderr is not a terminal: the shape a shard's log gets.
+TEST(Progress, LogsTheRateAndEtaEveryIntervalWhenStderrIsNotATerminal) {
+  ASSERT_EQ(::isatty(STDERR_FILENO), 0);
+  tega::init_logging(1);
+  testing::internal::CaptureStderr();
+  {
+    tega::Progress progress("frames of x", 4, "frames", std::chrono::milliseconds(20));
+    for (int i = 0; i < 4; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(30));
+      progress.advance();
+    }
+  }
+  const std::string log = testing::internal::GetCapturedStderr();
+  EXPECT_NE(log.find("frames of x  1/4 frames"), std::string::npos) << log;
+  EXPECT_NE(log.find("frames of x  3/4 frames"), std::string::npos) << log;
+  EXPECT_NE(log.find("ETA 0:00"), std::string::npos) << log;
+  EXPECT_NE(log.find("frames of x  4/4 frames"), std::string::npos) << log;
+  EXPECT_NE(log.find(" in 0:00"), std::string::npos) << log;
+  EXPECT_EQ(log.find('\r'), std::string::npos) << "no terminal redraws in a log";
 }
 
 }  // namespace
