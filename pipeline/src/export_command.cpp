@@ -27,7 +27,7 @@ void add_export_command(CLI::App& app) {
   cmd->add_option("--out", args->out,
                   "One frame: the .ply file. Several frames (or --meshes): a directory of <frame>.ply.")
       ->required();
-  cmd->add_option("--frame", args->frames, "Dataset frame id(s), comma-separated; 'all' for every frame.")->delimiter(',');
+  cmd->add_option("--frame", args->frames, "Dataset frame id(s), comma-separated; 'all' for every frame, 'first' for the first training frame.")->delimiter(',');
   cmd->add_option("--meshes", args->meshes,
                   "Export a directory of meshes (.bin/.obj/.ply, template topology, world space) instead of dataset frames.");
   cmd->add_option("--mesh-pose", args->mesh_pose, "Dataset frame whose head pose the --meshes take (default: the first training frame).");
@@ -49,6 +49,8 @@ void add_export_command(CLI::App& app) {
       if (ids == std::vector<std::string>{"all"}) {
         ids.clear();
         for (const auto& f : dataset.frames) ids.push_back(f.id);
+      } else if (ids == std::vector<std::string>{"first"}) {
+        ids = {dataset.train.frames.at(0)};
       }
       frames = tools::dataset_frames(dataset, ids);
     }

@@ -1,5 +1,7 @@
 #include "tega/pipeline/stage_kinds.h"
 
+#include <algorithm>
+
 namespace tega::pipeline {
 namespace {
 
@@ -120,6 +122,29 @@ std::vector<StageKind> make_stage_kinds() {
                       p);
   };
   kinds.push_back(render);
+
+  // Without `frame` or `meshes` one PLY, of the first training frame: every
+  // frame of a studio subject would be gigabytes of Gaussians each.
+  StageKind export_ply;
+  export_ply.name = "export";
+  export_ply.summary = "exports posed Gaussians as 3D Gaussian Splatting PLY files (tega export)";
+  export_ply.subcommand = {"export"};
+  export_ply.needs = {"run", "dataset"};
+  export_ply.provides = {{"export", "export"}};
+  export_ply.options_as = OptionsAs::flags;
+  export_ply.flag_options = {"frame", "meshes", "mesh_pose", "head_space", "device"};
+  export_ply.path_options = {"meshes"};
+  export_ply.device_option = "device";
+  export_ply.arguments = [](const ShardPaths& p) {
+    std::vector<std::string> arguments{"--model", p.artifacts.at("run").string(), "--data",
+                                       p.artifacts.at("dataset").string(), "--out", (p.output / "export").string()};
+    const auto& flags = p.option_flags;
+    if (std::find(flags.begin(), flags.end(), "--frame") == flags.end() &&
+        std::find(flags.begin(), flags.end(), "--meshes") == flags.end())
+      arguments.insert(arguments.end(), {"--frame", "first"});
+    return with_flags(arguments, p);
+  };
+  kinds.push_back(export_ply);
 
   StageKind capture;
   capture.name = "capture";
