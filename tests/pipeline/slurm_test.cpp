@@ -1,13 +1,15 @@
-// `tega run --executor slurm` on a real one-node Slurm cluster that the test starts itself: the
-// committed outputs equal the local executor's byte for byte, even when a job's command, or a whole
-// job with its batch script, is killed with SIGKILL mid-run (each is submitted again), and
-// `tega status` shows the Slurm jobs.
+// `tega run --executor slurm` on a real one-node Slurm cluster that the test starts itself: the two
+// synth shards, ready together, go out as one job array; the committed outputs equal the local
+// executor's byte for byte, even when an array task's command, or a whole job with its batch
+// script, is killed with SIGKILL mid-run (each is submitted again), and `tega status` shows the
+// Slurm jobs, an array task as <array>_<task>.
 
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
 
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <thread>
 
@@ -22,7 +24,7 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-// Two subjects through synth and dataset check: four shards.
+// Two subjects through synth and dataset check: four shards, the two synth ones ready at once.
 std::string slurm_test_config() {
   return "workspace: unused\nsubjects:\n  alice: {}\n  bob: {options: {synth: {seed: 2}}}\n"
          "stages:\n  synth:\n    options:\n" +
@@ -67,6 +69,13 @@ pid_t parent_of(pid_t pid) {
 
 bool still_running(pid_t pid) { return ::waitpid(pid, nullptr, WNOHANG) == 0; }
 
+// The Slurm job id that `tega run` logged for a shard's first submission; "" when none.
+std::string first_slurm_job(const std::string& run_output, const std::string& shard) {
+  std::smatch match;
+  const std::regex submitted(shard + ": Slurm job ([0-9_]+)");
+  return std::regex_search(run_output, match, submitted) ? match[1].str() : "";
+}
+
 // A `tega run` that a failed assertion left running would poll a stopped cluster for ever.
 struct KillOnExit {
   pid_t pid;
@@ -97,9 +106,12 @@ TEST(SlurmExecutor, RunsShardsAsSlurmJobsAndRequeuesKilledOnes) {
     ASSERT_GT(run, 0);
     const KillOnExit stop_run_on_failure{run};
 
-    // Kill bob's synth command the moment it runs on the node: its batch script reports the signal.
+    // Kill bob's synth command (an array task's) the moment it runs on the node: its batch script
+    // reports the signal. Stopped first, it cannot finish while `tega status` looks at its job.
     const pid_t synth = wait_for_shard_process("synth", (ws / "synth/.staging-bob").string());
     ASSERT_GT(synth, 0) << "synth/bob never ran\n" << cluster.daemon_logs();
+    ::kill(synth, SIGSTOP);
+    const std::string status_of_array = run_tega({"status", ws.string()}, dir.path()).output;
     ::kill(synth, SIGKILL);
     // Kill alice's check with its batch script, as a crashing node would: no exit status at all.
     const pid_t check = wait_for_shard_process("dataset", (ws / "synth/alice").string());
@@ -120,7 +132,14 @@ TEST(SlurmExecutor, RunsShardsAsSlurmJobsAndRequeuesKilledOnes) {
     const std::string run_output = read_text_file(output);
     ASSERT_EQ(exit_code, 0) << run_output << "\n" << cluster.daemon_logs();
     EXPECT_TRUE(status_showed_a_job);
-    EXPECT_NE(run_output.find("synth/bob: Slurm job"), std::string::npos) << run_output;
+    const std::string alice_task = first_slurm_job(run_output, "synth/alice");
+    const std::string array = alice_task.substr(0, alice_task.find('_'));
+    EXPECT_EQ(alice_task, array + "_0") << run_output;
+    EXPECT_EQ(first_slurm_job(run_output, "synth/bob"), array + "_1") << run_output;
+    EXPECT_NE(status_of_array.find("slurm job " + array + "_1 "), std::string::npos) << status_of_array;
+    EXPECT_NE(read_text_file(ws / "logs/synth/alice.log").find("[slurm job " + array + "_0 on "), std::string::npos);
+    // Requeued alone, bob's synth went out as a plain job.
+    EXPECT_TRUE(std::regex_search(run_output, std::regex("synth/bob: Slurm job [0-9]+\n"))) << run_output;
     EXPECT_NE(run_output.find("killed by signal 9; submitting it again (requeue 1 of 2)"), std::string::npos)
         << run_output;
     EXPECT_NE(run_output.find("ended without the command's exit status; submitting it again (requeue 1 of 2)"),
@@ -132,6 +151,7 @@ TEST(SlurmExecutor, RunsShardsAsSlurmJobsAndRequeuesKilledOnes) {
     EXPECT_EQ(attempts(ws, "check", "bob"), 1);
     EXPECT_EQ(committed_outputs(ws), committed_outputs(dir / "local"));
     EXPECT_TRUE(staging_dirs(ws).empty());
+    EXPECT_FALSE(fs::exists(ws / "logs/synth" / ("slurm-" + alice_task + ".out")));  // appended to the log
   }
   // The cluster's daemons and every job's process are gone.
   EXPECT_TRUE(wait_until_no_process_mentions(cluster_dir, std::chrono::seconds(5)));

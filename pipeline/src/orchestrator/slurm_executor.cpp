@@ -7,9 +7,11 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -144,6 +146,57 @@ std::string slurm_filename(const fs::path& file) {
   return out;
 }
 
+// Runs sbatch --parsable and returns the job id it prints; throws naming `what` it submitted.
+std::string submitted_job_id(const std::vector<std::string>& sbatch_args, const std::string& what) {
+  const ProgramResult result = run_program(sbatch_args);
+  // --parsable prints "<id>" or "<id>;<cluster>".
+  const std::string id = result.output.substr(0, result.output.find_first_of(";\n"));
+  if (result.exit_code != 0 || id.empty() || id.find_first_not_of("0123456789") != std::string::npos) {
+    throw Error("sbatch failed for " + what + ": " + last_line(result.output));
+  }
+  return id;
+}
+
+std::string stage_of(const Job& job) { return job.id.substr(0, job.id.find('/')); }
+
+bool same_resources(const Resources& a, const Resources& b) { return a.gpu_device == b.gpu_device; }
+
+// Slurm's default MaxArraySize (1001) allows task indices 0 to 1000.
+constexpr size_t kMaxArrayTasks = 1001;
+
+// Jobs that one sbatch can run as an array: those of one stage asking for the same resources.
+std::vector<std::vector<Job>> array_groups(std::vector<Job> jobs) {
+  std::vector<std::vector<Job>> groups;
+  for (Job& job : jobs) {
+    auto group = std::find_if(groups.begin(), groups.end(), [&](const std::vector<Job>& g) {
+      return g.size() < kMaxArrayTasks && stage_of(g.front()) == stage_of(job) &&
+             same_resources(g.front().resources, job.resources);
+    });
+    if (group == groups.end()) group = groups.emplace(groups.end());
+    group->push_back(std::move(job));
+  }
+  return groups;
+}
+
+std::string job_ids(const std::vector<Job>& jobs) {
+  std::string ids;
+  for (const Job& job : jobs) ids += (ids.empty() ? "" : ", ") + job.id;
+  return ids;
+}
+
+const char* const kArrayScriptName = "slurm-array.sh";
+
+// The file of Slurm's own output for array task `task`; "%A_%a" gives sbatch's pattern for them all.
+std::string array_task_output_name(const std::string& task) { return "slurm-" + task + ".out"; }
+
+// A plain job's Slurm output is its log; an array task's goes to a file of its own until it ends.
+void append_to_log(const fs::path& slurm_output, const fs::path& log) {
+  if (slurm_output.empty() || !fs::exists(slurm_output)) return;
+  const std::string text = read_text_file(slurm_output);
+  if (!text.empty()) std::ofstream(log, std::ios::app) << text;
+  fs::remove(slurm_output);
+}
+
 }  // namespace
 
 SlurmExecutor::SlurmExecutor(SlurmOptions options)
@@ -165,52 +218,98 @@ SlurmExecutor::~SlurmExecutor() {
 
 void SlurmExecutor::submit(Job job) { queue_.push_back(std::move(job)); }
 
-std::string SlurmExecutor::sbatch(const Job& job) const {
+void SlurmExecutor::prepare(const Job& job) const {
   check_gpu_device(job, options_.gpus_per_job);
   fs::create_directories(job.log_file.parent_path());
   const SlurmJobFiles files = slurm_job_files(job.log_file);
   fs::remove(files.exit_file);
   write_text_atomic(files.script, batch_script(job, files.exit_file));
+}
 
+std::vector<std::string> SlurmExecutor::sbatch_arguments(const std::string& name, const std::string& output,
+                                                         const Resources& resources) const {
   std::vector<std::string> args = {sbatch_.string(),
                                    "--parsable",
-                                   "--job-name=" + options_.job_name_prefix + job.id,
-                                   "--output=" + slurm_filename(job.log_file),
-                                   "--error=" + slurm_filename(job.log_file),
+                                   "--job-name=" + name,
+                                   "--output=" + output,
+                                   "--error=" + output,
                                    "--open-mode=append",
                                    "--export=ALL",
                                    "--no-requeue"};  // requeues are ours: the shard is prepared afresh first
   if (!options_.partition.empty()) args.push_back("--partition=" + options_.partition);
-  if (!job.resources.gpu_device.empty()) args.push_back("--gres=gpu:" + std::to_string(options_.gpus_per_job));
-  args.push_back(files.script.string());
-  const ProgramResult result = run_program(args);
-  // --parsable prints "<id>" or "<id>;<cluster>".
-  const std::string id = result.output.substr(0, result.output.find_first_of(";\n"));
-  if (result.exit_code != 0 || id.empty() || id.find_first_not_of("0123456789") != std::string::npos) {
-    throw Error("sbatch failed for " + job.id + ": " + last_line(result.output));
+  if (!resources.gpu_device.empty()) args.push_back("--gres=gpu:" + std::to_string(options_.gpus_per_job));
+  return args;
+}
+
+std::string SlurmExecutor::sbatch_job(const Job& job) const {
+  std::vector<std::string> args =
+      sbatch_arguments(options_.job_name_prefix + job.id, slurm_filename(job.log_file), job.resources);
+  args.push_back(slurm_job_files(job.log_file).script.string());
+  return submitted_job_id(args, job.id);
+}
+
+std::string SlurmExecutor::sbatch_array(const std::vector<Job>& jobs) const {
+  const fs::path dir = jobs.front().log_file.parent_path();
+  write_text_atomic(dir / kArrayScriptName, array_batch_script(jobs));
+  std::vector<std::string> args =
+      sbatch_arguments(options_.job_name_prefix + stage_of(jobs.front()),
+                       slurm_filename(dir) + "/" + array_task_output_name("%A_%a"), jobs.front().resources);
+  args.push_back("--array=0-" + std::to_string(jobs.size() - 1));
+  args.push_back((dir / kArrayScriptName).string());
+  return submitted_job_id(args, "the job array of " + job_ids(jobs));
+}
+
+void SlurmExecutor::submit_group(std::vector<Job>& group) {
+  if (group.size() == 1) {
+    const std::string slurm_id = sbatch_job(group.front());
+    track(std::move(group.front()), slurm_id);
+    return;
   }
-  write_slurm_job_record(files.record, {id, "PENDING"});
-  return id;
+  const std::string array_id = sbatch_array(group);
+  const fs::path output_dir = group.front().log_file.parent_path();
+  for (size_t task = 0; task < group.size(); ++task) {
+    const std::string slurm_id = array_id + "_" + std::to_string(task);
+    track(std::move(group[task]), slurm_id, output_dir / array_task_output_name(slurm_id));
+  }
+}
+
+void SlurmExecutor::track(Job job, const std::string& slurm_id, fs::path slurm_output) {
+  spdlog::info("{}: Slurm job {}", job.id, slurm_id);
+  write_slurm_job_record(slurm_job_files(job.log_file).record, {slurm_id, "PENDING"});
+  submitted_[slurm_id] = {std::move(job), "PENDING", Clock::now(), std::nullopt, std::move(slurm_output)};
 }
 
 void SlurmExecutor::submit_queued(std::vector<JobResult>& results) {
-  for (; !queue_.empty(); queue_.pop_front()) {
-    Job& job = queue_.front();
+  const auto could_not_start = [&](const Job& job, const std::exception& e) {
+    results.push_back({job.id, false, std::string("could not start: ") + e.what(), 0, false});
+  };
+  std::vector<Job> prepared;
+  for (Job& job : queue_) {
     try {
-      const std::string slurm_id = sbatch(job);
-      spdlog::info("{}: Slurm job {}", job.id, slurm_id);
-      submitted_[slurm_id] = {std::move(job), "PENDING", Clock::now(), std::nullopt};
+      prepare(job);
+      prepared.push_back(std::move(job));
     } catch (const std::exception& e) {
-      results.push_back({job.id, false, std::string("could not start: ") + e.what(), 0, false});
+      could_not_start(job, e);
+    }
+  }
+  queue_.clear();
+  for (std::vector<Job>& group : array_groups(std::move(prepared))) {
+    try {
+      submit_group(group);
+    } catch (const std::exception& e) {
+      for (const Job& job : group) could_not_start(job, e);
     }
   }
 }
 
 std::optional<std::map<std::string, std::string>> SlurmExecutor::queue_states() const {
+  std::set<std::string> jobs;  // an array's tasks are asked about by the array's id
+  for (const auto& [slurm_id, job] : submitted_) jobs.insert(slurm_id.substr(0, slurm_id.find('_')));
   std::string ids;
-  for (const auto& [slurm_id, job] : submitted_) ids += (ids.empty() ? "" : ",") + slurm_id;
-  const ProgramResult result =
-      run_program({squeue_.string(), "--noheader", "--states=all", "--format=%i|%T", "--jobs=" + ids});
+  for (const auto& id : jobs) ids += (ids.empty() ? "" : ",") + id;
+  // --array: a line per array task, "<array>_<task>", pending ones too (else shown as "<array>_[0-3]").
+  const ProgramResult result = run_program(
+      {squeue_.string(), "--noheader", "--array", "--states=all", "--format=%i|%T", "--jobs=" + ids});
   std::map<std::string, std::string> states;
   if (result.exit_code != 0) {
     // squeue fails outright when it knows none of the ids: every job is long over.
@@ -253,6 +352,7 @@ bool SlurmExecutor::conclude(Submitted& job, const std::string& slurm_id, std::v
     if (!job.over_without_exit_file) job.over_without_exit_file = Clock::now();
     if (Clock::now() - *job.over_without_exit_file < options_.exit_file_grace) return false;
   }
+  append_to_log(job.slurm_output, job.job.log_file);
   const double seconds = std::chrono::duration<double>(Clock::now() - job.submitted).count();
   const std::string slurm = "Slurm job " + slurm_id + " (" + job.state + ")";
   if (status && *status <= 128) {
@@ -320,7 +420,10 @@ void SlurmExecutor::cancel_all() {
     }
     std::this_thread::sleep_for(std::min(options_.poll_interval, std::chrono::milliseconds(500)));
   }
-  for (const auto& [slurm_id, job] : submitted_) fs::remove(slurm_job_files(job.job.log_file).record);
+  for (const auto& [slurm_id, job] : submitted_) {
+    append_to_log(job.slurm_output, job.job.log_file);
+    fs::remove(slurm_job_files(job.job.log_file).record);
+  }
   submitted_.clear();
 }
 

@@ -1,8 +1,9 @@
 #pragma once
 // Executors run shard commands; the orchestrator decides what runs and
 // commits the results. A job is a command line, a log file and the resources
-// it needs, so a cluster executor (SlurmExecutor: one sbatch per job, polled
-// through squeue) runs the very same jobs without any stage changing.
+// it needs, so a cluster executor (SlurmExecutor: Slurm batch jobs and job
+// arrays, polled through squeue) runs the very same jobs without any stage
+// changing.
 
 #include <chrono>
 #include <filesystem>

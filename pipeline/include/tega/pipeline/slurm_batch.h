@@ -7,11 +7,21 @@
 //                       that Slurm reports ended without it was lost (node failure, preemption, the
 //                       script killed), not failed by its command
 //   <shard>.slurm.json  the Slurm job id and state while the job is queued or running, so that
-//                       `tega status` can show them without asking Slurm
+//                       `tega status` can show them without asking Slurm; an array task's id is
+//                       "<array>_<task>", as squeue names it
+//
+// Shards of one stage submitted together go out as one job array, with two files in the first
+// shard's log directory:
+//
+//   slurm-array.sh        the array's batch script: task i runs the i-th shard's <shard>.slurm.sh,
+//                         its output appended to that shard's log; the next array rewrites it
+//   slurm-<array>_<task>.out  Slurm's own messages for one task (a time limit, a script that could
+//                         not start), appended to the shard's log when the task ends
 
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "tega/pipeline/executor.h"
 
@@ -28,6 +38,10 @@ SlurmJobFiles slurm_job_files(const std::filesystem::path& log_file);
 // The batch script of `job`. Every value from the job is shell-quoted; the log's first line per
 // attempt is "=== <time> <id>: <command> [slurm job <id> on <node>]", as LocalExecutor's header.
 std::string batch_script(const Job& job, const std::filesystem::path& exit_file);
+
+// The batch script of a job array of `jobs`, whose shard scripts (batch_script) are already written:
+// task i (SLURM_ARRAY_TASK_ID) runs jobs[i]'s. Every path is shell-quoted.
+std::string array_batch_script(const std::vector<Job>& jobs);
 
 struct SlurmJobRecord {
   std::string job_id;

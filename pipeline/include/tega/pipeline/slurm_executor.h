@@ -1,7 +1,10 @@
 #pragma once
 // Runs every job as a Slurm batch job (`tega run --executor slurm`, docs/pipeline.md#running-on-a-slurm-cluster).
 //
-// submit() only queues; wait() calls sbatch for queued jobs and polls squeue. A job is over when
+// submit() only queues; wait() calls sbatch for queued jobs and polls squeue. Queued jobs of one stage
+// (the id's part before '/') that ask for the same resources go out as one job array, a task per
+// job, known by its "<array>_<task>" id from then on (squeue -r, scancel, the status record); a
+// job alone in its group is a plain job. A job is over when
 // squeue reports a final state or no longer knows it. How it ended comes from the exit file its
 // batch script writes (slurm_batch.h), not from sacct: that needs accounting storage, which many
 // small clusters (and the test's one-node cluster) do not run, and the file says what the command
@@ -20,6 +23,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "tega/pipeline/executor.h"
 
@@ -66,10 +70,17 @@ class SlurmExecutor : public Executor {
     std::string state;  // squeue's, from the last poll
     std::chrono::steady_clock::time_point submitted;
     std::optional<std::chrono::steady_clock::time_point> over_without_exit_file;
+    std::filesystem::path slurm_output;  // an array task's own Slurm output (slurm_batch.h); else empty
   };
 
   void submit_queued(std::vector<JobResult>& results);
-  std::string sbatch(const Job& job) const;  // the Slurm job id; throws tega::Error
+  void prepare(const Job& job) const;  // checks the job and writes its batch script; throws tega::Error
+  std::vector<std::string> sbatch_arguments(const std::string& name, const std::string& output,
+                                            const Resources& resources) const;
+  std::string sbatch_job(const Job& job) const;  // the Slurm job id; throws tega::Error
+  std::string sbatch_array(const std::vector<Job>& jobs) const;  // the array's Slurm job id; throws tega::Error
+  void submit_group(std::vector<Job>& group);  // one plain job or one array; throws tega::Error
+  void track(Job job, const std::string& slurm_id, std::filesystem::path slurm_output = {});
   // Slurm job id -> state, for those squeue still knows; nullopt when squeue could not be asked.
   std::optional<std::map<std::string, std::string>> queue_states() const;
   void poll(std::vector<JobResult>& results);
@@ -80,7 +91,7 @@ class SlurmExecutor : public Executor {
   SlurmOptions options_;
   std::filesystem::path sbatch_, squeue_, scancel_;
   std::deque<Job> queue_;
-  std::map<std::string, Submitted> submitted_;  // by Slurm job id
+  std::map<std::string, Submitted> submitted_;  // by Slurm job id, "<array>_<task>" for an array task
   std::map<std::string, int> requeues_;         // by job id
   std::chrono::steady_clock::time_point next_poll_;
 };
