@@ -70,17 +70,6 @@ double median(std::vector<double> values) {
 }
 
 #ifdef TEGA_REPORT_HAVE_MVS
-// Meshes are in the world of the rig MVS used: a calibrated rig has its own
-// world (its first camera's, by default), the studio's truth the studio's.
-// The two are tied by the first camera, as the calibration's score does.
-RigidTransform mesh_to_truth_world(const SubjectOutputs& subject) {
-  const StageOutput* calibrate = subject.first_of_kind("calibrate");
-  if (!calibrate || !calibrate->committed) return {};  // the capture's own rig: the truth's world
-  const Rig calibrated = read_rig_json(artifact(*calibrate, "rig"));
-  const Rig truth = read_rig_json(subject.truth / "rig.json");
-  if (calibrated.cameras.empty() || truth.cameras.empty()) throw Error(artifact(*calibrate, "rig"), "has no cameras");
-  return truth.cameras[0].world_to_camera.inverse() * calibrated.cameras[0].world_to_camera;
-}
 
 // Targets of the MVS issue (docs/mvs.md#accuracy): at 512 x 384 a median
 // accuracy of 2 mm and 90 % of the face within 3 mm; at full size 0.3 mm and 95 % within 1 mm.
@@ -95,7 +84,7 @@ void score_meshes(const std::string& stage, const fs::path& meshes,
   for (const auto& [take, records] : takes)
     count += spread(records.size(), size_t(context.options.scored_frames_per_take)).size();
   Progress progress("scoring MVS meshes against the studio's truth", int64_t(count), "meshes");
-  const RigidTransform to_truth = mesh_to_truth_world(context.subject);
+  const RigidTransform to_truth = calibrated_to_truth_world(context.subject);
   mvs::EvaluationOptions options;
   options.tolerances_m = {0.001, 0.002, 0.003};
   Table table{{"take", "frame", "accuracy median mm", "accuracy p90 mm", "within 1 / 2 / 3 mm %"}, {}};

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "tega/core/error.h"
+#include "tega/core/rig.h"
 
 namespace tega::report {
 namespace fs = std::filesystem;
@@ -40,6 +41,15 @@ std::vector<size_t> spread(size_t n, size_t count) {
   if (count == 1) return {n / 2};
   for (size_t k = 0; k < count; ++k) out.push_back(k * (n - 1) / (count - 1));
   return out;
+}
+
+RigidTransform calibrated_to_truth_world(const SubjectOutputs& subject) {
+  const StageOutput* calibrate = subject.first_of_kind("calibrate");
+  if (!calibrate || !calibrate->committed) return {};
+  const Rig calibrated = read_rig_json(artifact(*calibrate, "rig"));
+  const Rig truth = read_rig_json(subject.truth / "rig.json");
+  if (calibrated.cameras.empty() || truth.cameras.empty()) throw Error(artifact(*calibrate, "rig"), "has no cameras");
+  return truth.cameras[0].world_to_camera.inverse() * calibrated.cameras[0].world_to_camera;
 }
 
 const fs::path& artifact(const StageOutput& stage, const std::string& name) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "page.h"
+#include "tega/core/geometry.h"
 #include "tega/report/report.h"
 #include "workspace_outputs.h"
 
@@ -49,6 +50,10 @@ std::string fixed(double value, int decimals);  // "nan" / "inf" spelled out
 std::string verdict(bool met);
 // `count` indices spread evenly over [0, n), first and last included when count >= 2.
 std::vector<size_t> spread(size_t n, size_t count);
+// From the world of the subject's calibrated rig, which later stages' meshes and poses are in, to
+// the studio's truth's: the two are tied by the first camera, as the calibration's score does.
+// The identity where no calibrate stage ran (the stages then used the capture's own rig, the truth's).
+RigidTransform calibrated_to_truth_world(const SubjectOutputs& subject);
 // The artifact's path; throws tega::Error when the stage's kind provides no such artifact.
 const std::filesystem::path& artifact(const StageOutput& stage, const std::string& name);
 

@@ -84,7 +84,8 @@ std::string or_dash(double value, int decimals) { return std::isfinite(value) ? 
 void score_take(const std::string& stage, const fs::path& tracked, const std::string& take, Section& section,
                 ReportContext& context) {
   logging::info("report: scoring tracked take %s against the studio's truth", take.c_str());
-  const tracking::TrackScores s = tracking::score_against_studio(tracked, context.subject.truth, take);
+  const tracking::TrackScores s = tracking::score_against_studio(tracked, context.subject.truth, take,
+                                                                    calibrated_to_truth_world(context.subject));
   Table table{{"measure", "value", "target"}, {}};
   const auto add = [&](const std::string& measure, double value, int decimals, const std::string& unit, double target,
                        bool at_most) {

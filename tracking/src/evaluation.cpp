@@ -146,11 +146,15 @@ TrackScores score_frames(const std::vector<ScoredFrame>& tracked, const fs::path
   return scores;
 }
 
-TrackScores score_against_studio(const fs::path& tracked, const fs::path& capture, const std::string& take) {
+TrackScores score_against_studio(const fs::path& tracked, const fs::path& capture, const std::string& take,
+                                 const RigidTransform& tracked_to_truth) {
   std::vector<ScoredFrame> scored;
   for (const TrackedFrame& frame : read_tracked_take(tracked, take)) {
     if (!frame.tracked()) continue;
-    scored.push_back({frame.frame, read_vertices_bin(frame.mesh), frame.head_to_world.R, frame.expression});
+    Vertices vertices = read_vertices_bin(frame.mesh);
+    for (Eigen::Index v = 0; v < vertices.rows(); ++v)
+      vertices.row(v) = tracked_to_truth.apply(vertices.row(v).transpose().cast<double>()).cast<float>().transpose();
+    scored.push_back({frame.frame, std::move(vertices), tracked_to_truth.R * frame.head_to_world.R, frame.expression});
   }
   if (scored.empty()) throw Error(tracked / take, "has no tracked frame to score");
   return score_frames(scored, capture, take);

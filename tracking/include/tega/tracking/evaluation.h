@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "tega/core/geometry.h"
 #include "tega/core/mesh.h"
 #include "tega/tracking/landmarks.h"
 
@@ -53,7 +54,9 @@ TrackScores score_frames(const std::vector<ScoredFrame>& frames, const std::file
                          const std::string& take);
 
 // The tracked frames of TRACKED/<take>; `capture`: the studio's capture with ground_truth/.
+// `tracked_to_truth` moves the tracked meshes and poses from the world of the rig tracking used (a
+// calibrated rig has its own, its first camera's by default) into the studio's.
 TrackScores score_against_studio(const std::filesystem::path& tracked, const std::filesystem::path& capture,
-                                 const std::string& take);
+                                 const std::string& take, const RigidTransform& tracked_to_truth = {});
 
 }  // namespace tega::tracking
