@@ -11,6 +11,7 @@
 #include "pipeline_test_support.h"
 #include "tega/core/files.h"
 #include "tega/core/image.h"
+#include "tega/core/rig.h"
 #include "tega/pipeline/manifest.h"
 #include "test_support.h"
 
@@ -198,7 +199,12 @@ void commit_by_hand(const fs::path& shard, const std::string& stage, const std::
 TEST_F(ReportStudio, ZTrackedAndMattedShardsAreShownAndScoredAgainstTheTruth) {
   const fs::path capture = workspace() / "synth/alice/capture";
   fs::create_directories(workspace() / "track/alice");
-  tracking::write_studio_truth_as_tracked(capture, workspace() / "track/alice/tracked");
+  // Where tracking with the calibrated rig would put them: in its world.
+  const Rig calibrated = read_rig_json(workspace() / "calibrate/alice/rig.json");
+  const Rig truth = read_rig_json(capture / "rig.json");
+  tracking::write_studio_truth_as_tracked(
+      capture, workspace() / "track/alice/tracked", {},
+      calibrated.cameras[0].world_to_camera.inverse() * truth.cameras[0].world_to_camera);
   commit_by_hand(workspace() / "track/alice", "track", "track");
   const fs::path take = workspace() / "matte/alice/mattes/expressions";
   const json cameras = json::parse(read_text_file(capture / "takes/expressions/take.json"))["cameras"];

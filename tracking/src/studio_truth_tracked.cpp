@@ -11,7 +11,8 @@
 namespace tega::tracking {
 namespace fs = std::filesystem;
 
-void write_studio_truth_as_tracked(const fs::path& capture, const fs::path& out, const std::vector<std::string>& takes) {
+void write_studio_truth_as_tracked(const fs::path& capture, const fs::path& out, const std::vector<std::string>& takes,
+                                   const RigidTransform& truth_to_world) {
   if (fs::exists(out)) throw Error(out, "exists already");
   const fs::path head = capture / "ground_truth" / "head";
   const Mesh neutral = read_obj(head / "template.obj");
@@ -38,11 +39,20 @@ void write_studio_truth_as_tracked(const fs::path& capture, const fs::path& out,
       const int frame = f.at("index");
       char name[16];
       std::snprintf(name, sizeof name, "%06d", frame);
-      fs::copy_file(truth / "coarse" / (std::string(name) + ".bin"), out / take / (std::string(name) + ".bin"));
+      Vertices vertices = read_vertices_bin(truth / "coarse" / (std::string(name) + ".bin"), neutral.num_vertices());
+      for (Eigen::Index v = 0; v < vertices.rows(); ++v)
+        vertices.row(v) = truth_to_world.apply(vertices.row(v).transpose().cast<double>()).cast<float>().transpose();
+      write_vertices_bin(vertices, out / take / (std::string(name) + ".bin"));
+      Eigen::Matrix<double, 3, 4> head_to_truth;
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c) head_to_truth(r, c) = f.at("head_to_world").at(r).at(c);
+      const Eigen::Matrix<double, 3, 4> head_to_world = (truth_to_world * RigidTransform::from_matrix(head_to_truth)).matrix();
+      nlohmann::json pose = nlohmann::json::array();
+      for (int r = 0; r < 3; ++r) pose.push_back({head_to_world(r, 0), head_to_world(r, 1), head_to_world(r, 2), head_to_world(r, 3)});
       const nlohmann::json record = {
           {"frame", frame},
           {"status", "tracked"},
-          {"head_to_world", f.at("head_to_world")},
+          {"head_to_world", pose},
           {"expression", f.at("expression")},
           {"residuals", {{"surface_median_mm", 0.0}, {"surface_p90_mm", 0.0}, {"inlier_fraction", 1.0}}},
           {"mesh", std::string(name) + ".bin"}};

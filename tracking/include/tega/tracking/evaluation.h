@@ -38,9 +38,12 @@ LandmarkSample studio_landmark_sample(const std::filesystem::path& capture, cons
 // its template as the subject (identity.json, identity_neutral.obj) and the
 // true coarse meshes and poses as tracked frames of `takes` (empty: every
 // performance take). Stages after tracking are tested on it apart from the
-// tracker's own error. `out` must not exist.
+// tracker's own error. `truth_to_world` moves the meshes and poses into the
+// world of another rig (a calibrated one: where tracking with it puts them).
+// `out` must not exist.
 void write_studio_truth_as_tracked(const std::filesystem::path& capture, const std::filesystem::path& out,
-                                   const std::vector<std::string>& takes = {});
+                                   const std::vector<std::string>& takes = {},
+                                   const RigidTransform& truth_to_world = {});
 
 // One tracked frame to score.
 struct ScoredFrame {
