@@ -151,7 +151,8 @@ int main(int argc, char** argv) {
   double voxel_size = 0;
   std::string cloud_file;
   bool verbose = false;
-  std::string device = "cpu", capture = (fs::temp_directory_path() / "tega-mvs-bench").string(), out, config;
+  std::string device = "cpu", capture = (fs::temp_directory_path() / "tega-mvs-bench").string(), out, config,
+              meshes_out;
   app.add_option("--cameras", cameras, "Cameras.");
   app.add_option("--width", width, "Image width.");
   app.add_option("--height", height, "Image height.");
@@ -162,6 +163,10 @@ int main(int argc, char** argv) {
   app.add_option("--threads", threads, "CPU threads (0 = all).");
   app.add_option("--capture", capture, "Where the rendered capture is kept between runs (suffixed with its size).");
   app.add_option("--out", out, "Write the fused cloud (fused.ply) here, and the mesh (mesh.ply) where it is made.");
+#ifdef TEGA_BENCH_HAVE_SURFACE
+  app.add_option("--meshes-out", meshes_out,
+                 "Write the take's meshes as tega mvs lays them out (DIR/expressions/<frame>.ply), e.g. for bench/track.");
+#endif
   app.add_option("--window-radius", window_radius, "PatchMatch window radius in pixels (default: the options').");
   app.add_option("--window-step", window_step, "PatchMatch window step in pixels (default: the options').");
   app.add_option("--fusion-step", fusion_step, "Fuse every n-th pixel and row (default: the options').");
@@ -347,6 +352,16 @@ int main(int argc, char** argv) {
   for (int f = 0; f < take_frames; ++f) {
     std::printf("frame %d ", f);
     report_mesh(meshes[size_t(f)], root, f);
+  }
+  if (!meshes_out.empty()) {
+    const fs::path folder = fs::path(meshes_out) / "expressions";
+    fs::create_directories(folder);
+    for (int f = 0; f < take_frames; ++f) {
+      char name[32];
+      std::snprintf(name, sizeof name, "%06d.ply", f);
+      write_mesh(meshes[size_t(f)], folder / name);
+    }
+    std::printf("wrote the take's %d meshes under %s\n", take_frames, folder.c_str());
   }
 #endif
   return 0;

@@ -44,14 +44,14 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 int main(int argc, char** argv) {
   CLI::App app{"Time per frame of tega's template tracking (ICT-FaceKit topology)."};
   std::string model_dir = "../shared/data/ict-facekit", capture_dir, meshes_dir, landmarks;
-  int frames = 8, width = 512, height = 384, threads = 2;
+  int frames = 0, width = 512, height = 384, threads = 2;
   bool no_flow = false;
   app.add_option("--model", model_dir, "The ICT-FaceKit directory.");
   app.add_option("--capture", capture_dir, "A virtual-studio capture to track (default: render one).");
   std::vector<std::string> overrides;
   app.add_option("--set", overrides, "Override a tracking option, e.g. --set eyelids.enabled=false (repeatable).");
   app.add_option("--meshes", meshes_dir, "Its MVS meshes (MESHES/expressions/<frame>.ply; default: the true meshes).");
-  app.add_option("--frames", frames, "Frames of the take to render and track.");
+  app.add_option("--frames", frames, "Frames of the take to render and track (default: bench/track_studio.yaml's 10).");
   app.add_option("--width", width, "Image width of the rendered capture.");
   app.add_option("--height", height, "Image height of the rendered capture.");
   app.add_option("--threads", threads, "Worker threads (the target machine has 2 cores).");
@@ -85,17 +85,13 @@ int main(int argc, char** argv) {
   if (capture.empty()) {
     capture = fs::temp_directory_path() / "tega-track-bench";
     synth::Options studio;
+    load_options(studio, TEGA_BENCH_TRACK_STUDIO);
     studio.studio.width = width;
     studio.studio.height = height;
-    studio.frames = frames;
-    studio.calibration_frames = 0;
-    studio.takes = {"expressions"};
-    studio.test_takes = {};
+    if (frames > 0) studio.frames = frames;
     studio.head = model_dir;
-    studio.head_identity = {0.9, -0.6, 0.5, 0.3, -0.4};
-    studio.head_shape_detail_m = 0.002;
     studio.threads = threads;
-    std::printf("rendering %s (%d frames, 13 cameras, %dx%d)\n", capture.c_str(), frames, width, height);
+    std::printf("rendering %s (%d frames, 13 cameras, %dx%d)\n", capture.c_str(), studio.frames, width, height);
     synth::render_virtual_studio(studio, capture, true);
   }
 
