@@ -1,7 +1,11 @@
 // Where the head is before any frame says so: landmarks triangulated across
 // views where a detector finds the face, else the scan's front and the rig's
-// orientation; then rigid ICP on the parts of the face no expression moves.
+// orientation, turned a few ways; then rigid ICP on the parts of the face no
+// expression moves.
+#include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
+#include <optional>
 
 #include "frame_targets.h"
 #include "rigid_alignment.h"
@@ -14,6 +18,7 @@ namespace {
 constexpr int kRigidIcpIterations = 8;
 constexpr double kRigidIcpStartDistanceM = 0.04;
 constexpr double kFrontFacingCosine = 0.3;
+constexpr double kStartYawsDeg[] = {0, -15, 15, -30, 30};
 
 // The point closest to all rays (camera centre, unit direction) in the least-squares sense.
 Eigen::Vector3d closest_to_rays(const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>& rays) {
@@ -83,18 +88,18 @@ RigidTransform pose_from_rig(const HeadModel& model, const Vertices& neutral, co
   return pose;
 }
 
-}  // namespace
+struct RigidFit {
+  RigidTransform pose;
+  size_t supported = 0;  // rigid-part vertices with a scan point within the final bound
+};
 
-RigidTransform initial_pose(const HeadModel& model, const Vertices& neutral, const FrameObservation& frame,
-                            const std::vector<Camera>& cameras, const Options& options,
-                            const LandmarkDetector* landmarks) {
-  std::optional<RigidTransform> pose;
-  if (landmarks) pose = pose_from_landmarks(model, neutral, frame, cameras, *landmarks, options.landmarks.min_views);
-  if (!pose) pose = pose_from_rig(model, neutral, *frame.scan, cameras);
-
-  const SurfaceQuery scan(*frame.scan);
-  std::vector<RigidTransform> poses = {*pose};
+// Rigid ICP of the neutral head's rigid part, the bound shrinking from a few
+// centimetres to the surface term's first bound.
+RigidFit rigid_icp(const HeadModel& model, const Vertices& neutral, const SurfaceQuery& scan, const RigidTransform& start,
+                   const Options& options) {
+  std::vector<RigidTransform> poses = {start};
   std::vector<double> none;
+  size_t supported = 0;
   for (int it = 0; it < kRigidIcpIterations; ++it) {
     Vertices world = neutral;
     for (int v = 0; v < world.rows(); ++v)
@@ -110,12 +115,42 @@ RigidTransform initial_pose(const HeadModel& model, const Vertices& neutral, con
     problem.frames[0].surface.scale.robust_scale = options.surface.robust_scale;
     problem.iterations = 3 * options.coefficients.solver_iterations;  // once per take
     problem.threads = options.threads;
-    if (problem.frames[0].surface.targets.size() < 50)
-      throw Error("the scan does not meet the head model near where the head should be (" +
-                  std::to_string(problem.frames[0].surface.targets.size()) + " correspondences)");
+    supported = problem.frames[0].surface.targets.size();
+    if (supported < 50)
+      throw Error("the scan does not meet the head model near where the head should be (" + std::to_string(supported) +
+                  " correspondences)");
     fit_coefficients(problem, poses, none);
   }
-  return poses[0];
+  return {poses[0], supported};
+}
+
+}  // namespace
+
+RigidTransform initial_pose(const HeadModel& model, const Vertices& neutral, const FrameObservation& frame,
+                            const std::vector<Camera>& cameras, const Options& options,
+                            const LandmarkDetector* landmarks) {
+  const SurfaceQuery scan(*frame.scan);
+  if (landmarks) {
+    if (auto pose = pose_from_landmarks(model, neutral, frame, cameras, *landmarks, options.landmarks.min_views))
+      return rigid_icp(model, neutral, scan, *pose, options).pose;
+  }
+  // The rig only says roughly where the face looks; a head turned away from
+  // the rig's centre can pull ICP into a rolled, shifted fit of the brow and
+  // cheeks. So start turned either way too, about the face's centre and the
+  // rig's up axis, and keep the fit the most of the rigid part supports.
+  const RigidTransform guess = pose_from_rig(model, neutral, *frame.scan, cameras);
+  Eigen::Vector3d face = Eigen::Vector3d::Zero();
+  for (int v : model.fit_vertices) face += neutral.row(v).cast<double>().transpose();
+  const Eigen::Vector3d centre = guess.apply(face / double(model.fit_vertices.size()));
+  const Eigen::Vector3d up = guess.R.col(1);
+  std::optional<RigidFit> best;
+  for (const double yaw_deg : kStartYawsDeg) {
+    const Eigen::Matrix3d turn = Eigen::AngleAxisd(yaw_deg * M_PI / 180, up).toRotationMatrix();
+    const RigidTransform start{turn * guess.R, centre + turn * (guess.t - centre)};
+    RigidFit fit = rigid_icp(model, neutral, scan, start, options);
+    if (!best || fit.supported > best->supported) best = std::move(fit);
+  }
+  return best->pose;
 }
 
 }  // namespace tega::tracking
