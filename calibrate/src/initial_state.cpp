@@ -104,10 +104,18 @@ Intrinsics own_intrinsics(const std::vector<const BoardView*>& views, const Boar
     objects.push_back(object_points(*v, board));
     images.push_back(image_points(*v));
   }
+  // CALIB_USE_LU for determinism: calibrateCamera's default Levenberg-Marquardt
+  // step solves its ~130-unknown normal equations by SVD, which OpenCV hands to
+  // LAPACK's dgesdd (>= 25 unknowns); with ATLAS (Debian's default BLAS) its
+  // result depends on the alignment of OpenCV's heap scratch buffers, so the
+  // same views gave intrinsics differing by ~1e-10 from run to run, and the rig
+  // ~1e-14 after the bundle adjustment. The LU solve (OpenCV's own below 100
+  // unknowns, LAPACK's dgesv above) gave bit-identical intrinsics across heap
+  // layouts. The damped normal equations are well conditioned: same minimum.
   cv::Mat K, dist;
   std::vector<cv::Mat> rvecs, tvecs;
   cv::calibrateCamera(objects, images, cv::Size(size.width, size.height), K, dist, rvecs, tvecs,
-                      options.fix_k3 ? cv::CALIB_FIX_K3 : 0);
+                      cv::CALIB_USE_LU | (options.fix_k3 ? cv::CALIB_FIX_K3 : 0));
   return intrinsics_from(K, dist);
 }
 
