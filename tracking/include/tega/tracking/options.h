@@ -102,7 +102,7 @@ struct EyelidOptions {
   std::vector<std::string> shapes = {"eyeBlink_L", "eyeBlink_R"};
   double sigma = 0.05;               // blink values outside the agreeing range cost (distance / sigma)^2
   double weight = 0.3;
-  double tolerance = 0.1;            // covered fractions that differ by at most this agree
+  double tolerance = 0.03;           // covered fractions that differ by at most this agree
   double max_view_angle_deg = 45;    // cameras farther than this from the eye's front are not used
   int sample_step = 3;               // every n-th eyeball vertex is tested
   int min_samples = 30;              // an eye seen at fewer eyeball points is left out of the frame
