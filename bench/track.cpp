@@ -18,6 +18,7 @@
 #include "tega/tracking/evaluation.h"
 #include "tega/tracking/head_model.h"
 #include "tega/tracking/landmarks.h"
+#include "tega/tracking/photos.h"
 #include "tega/tracking/tracker.h"
 
 namespace fs = std::filesystem;
@@ -101,19 +102,21 @@ int main(int argc, char** argv) {
   const Rig rig = read_rig_json(capture / "rig.json");
   const TakeInfo take = read_take(capture / "takes" / "expressions");
   const Mesh fine_topology = meshes_dir.empty() ? read_obj(capture / "ground_truth" / "head" / "fine_topology.obj") : Mesh{};
-  const auto photos = [&](int frame) {
-    std::vector<Image8> images;
-    for (const auto& camera : take.cameras) images.push_back(read_image_u8(take.image_path(camera, frame)));
-    return images;
-  };
+  // As tega track reads them: downsampled within options.photo_max_side.
+  std::vector<Camera> cameras;
+  for (const auto& name : take.cameras) cameras.push_back(rig.camera(name));
+  const int photo_factor = tracking::photo_downsample(cameras, options.photo_max_side);
+  cameras = tracking::photo_cameras(cameras, photo_factor);
+  ThreadPool pool(threads);
+  const auto photos = [&](int frame) { return tracking::frame_photos(take, frame, photo_factor, pool); };
 
   const Mesh first = scan_of(capture, meshes_dir, fine_topology, 0);
   auto start = std::chrono::steady_clock::now();
   const tracking::SubjectIdentity subject =
-      tracking::fit_identity(model, {{&first, photos(0)}}, rig.cameras, options, detector.get());
+      tracking::fit_identity(model, {{&first, photos(0)}}, cameras, options, detector.get());
   std::printf("identity fit: %.2f s (once per subject)\n", seconds_since(start));
 
-  tracking::TakeTracker tracker(model, subject, rig.cameras, options, detector.get());
+  tracking::TakeTracker tracker(model, subject, cameras, options, detector.get());
   std::printf("%-6s %10s %12s %12s %12s %10s %12s %12s   %s\n", "frame", "scan faces", "image terms", "pose+expr",
               "corrections", "total (s)", "flow points", "flow rms px", "blink (eye covered in the photos)");
   double total = 0;

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "frame_record.h"
+#include "tega/tracking/photos.h"
 #include "report.h"
 #include "tega/core/error.h"
 #include "tega/core/files.h"
@@ -13,8 +14,6 @@
 #include "tega/core/rig.h"
 #include "tega/core/take.h"
 #include "tega/core/thread_pool.h"
-#include "tega/mvs/debayer.h"
-#include "tega/mvs/frame_views.h"
 #include "tega/tracking/landmarks.h"
 
 namespace tega::tracking {
@@ -40,21 +39,11 @@ std::vector<Camera> take_cameras(const TakeInfo& take, const Rig& rig, const fs:
   return cameras;
 }
 
-// The photos of a frame as recorded, RGB; an empty image where a camera has none.
-std::vector<Image8> frame_photos(const TakeInfo& take, int frame, ThreadPool& pool) {
-  std::vector<Image8> photos(take.cameras.size());
-  pool.parallel_for(0, int64_t(take.cameras.size()), [&](int64_t c) {
-    const std::string& camera = take.cameras[size_t(c)];
-    if (!take.has_image(camera, frame)) return;
-    const Image8 raw = read_image_u8(take.image_path(camera, frame));
-    photos[size_t(c)] = take.pixel_format.rfind("Bayer", 0) == 0 ? mvs::debayer(raw, take.pixel_format) : mvs::rgb_of(raw);
-  });
-  return photos;
-}
-
 struct TakeContext {
   const TakeInfo& take;
-  const std::vector<Camera>& cameras;
+  const std::vector<Camera>& cameras;        // as recorded: the report draws over full-size photos
+  int photo_factor;                          // the image terms' photos, downsampled by this ...
+  const std::vector<Camera>& photo_cameras;  // ... and their cameras
   const HeadModel& model;
   const SubjectIdentity& subject;
   const LandmarkDetector* landmarks;
@@ -79,7 +68,7 @@ void track_take(const TakeContext& t, const Options& options, TrackSummary& summ
   fs::create_directories(t.out);
   write_text_atomic(options_file, t.made_with);
 
-  TakeTracker tracker(t.model, t.subject, t.cameras, options, t.landmarks);
+  TakeTracker tracker(t.model, t.subject, t.photo_cameras, options, t.landmarks);
   std::vector<FrameRecord> records;
   Progress progress("track " + t.take.name, t.take.frames, "frames");
   bool follows = false;  // the next frame follows an accepted one
@@ -111,7 +100,7 @@ void track_take(const TakeContext& t, const Options& options, TrackSummary& summ
     }
     const Mesh scan = read_mesh(scan_file);
     FrameObservation observation{&scan, {}};
-    if (needs_photos(options, t.landmarks)) observation.images = frame_photos(t.take, frame, pool);
+    if (needs_photos(options, t.landmarks)) observation.images = frame_photos(t.take, frame, t.photo_factor, pool);
     if (!follows) tracker.break_sequence();
     FrameFit fit = tracker.track(observation);
     auto reason = tracker.rejection(fit);
@@ -165,6 +154,7 @@ void track_take(const TakeContext& t, const Options& options, TrackSummary& summ
 SubjectIdentity identity_of(const TrackRequest& request, const TakeInfo& first, const std::vector<Camera>& cameras,
                             const HeadModel& model, const Options& options, const LandmarkDetector* landmarks,
                             ThreadPool& pool) {
+  const int photo_factor = photo_downsample(cameras, options.photo_max_side);
   std::vector<Mesh> scans;
   std::vector<std::vector<Image8>> photos;
   for (int frame : options.identity_frames) {
@@ -173,12 +163,13 @@ SubjectIdentity identity_of(const TrackRequest& request, const TakeInfo& first, 
       throw Error(scan_file, "is missing: the identity is fitted to frame " + std::to_string(frame) + " of take " +
                                  first.name + " (identity_frames)");
     scans.push_back(read_mesh(scan_file));
-    photos.push_back(needs_photos(options, landmarks) ? frame_photos(first, frame, pool) : std::vector<Image8>{});
+    photos.push_back(needs_photos(options, landmarks) ? frame_photos(first, frame, photo_factor, pool)
+                                                      : std::vector<Image8>{});
   }
   std::vector<FrameObservation> frames;
   for (size_t i = 0; i < scans.size(); ++i) frames.push_back({&scans[i], photos[i]});
   logging::info("track: fitting the subject's identity to %zu frame(s) of take %s", frames.size(), first.name.c_str());
-  return fit_identity(model, frames, cameras, options, landmarks);
+  return fit_identity(model, frames, photo_cameras(cameras, photo_factor), options, landmarks);
 }
 
 }  // namespace
@@ -223,8 +214,12 @@ TrackSummary track_capture(const TrackRequest& request, const Options& options) 
   for (const auto& name : takes) {
     const TakeInfo take = read_take(capture.root / "takes" / name);
     const std::vector<Camera> cameras = take_cameras(take, rig, rig_file);
-    logging::info("track: take %s, %d frames, %zu cameras", name.c_str(), take.frames, cameras.size());
-    track_take({take, cameras, model, subject, landmarks.get(), request.meshes / name, request.out / name, made_with},
+    const int factor = photo_downsample(cameras, options.photo_max_side);
+    const std::vector<Camera> photo_rig = photo_cameras(cameras, factor);
+    logging::info("track: take %s, %d frames, %zu cameras, photos at 1/%d size", name.c_str(), take.frames,
+                  cameras.size(), factor);
+    track_take({take, cameras, factor, photo_rig, model, subject, landmarks.get(), request.meshes / name,
+                request.out / name, made_with},
                options, summary, pool);
     ++summary.takes;
   }

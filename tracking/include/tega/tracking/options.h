@@ -193,6 +193,7 @@ struct Options {
   int icp_iterations = 5;
   double min_inlier_fraction = 0.6;  // a frame whose fit vertices find the mesh less often fails
   double max_median_distance_m = 0.003;  // ... or whose median distance to it is larger
+  int photo_max_side = 1536;            // the image terms read photos at a whole fraction of their size within this
   int report_overlays = 3;              // frames of each take drawn over the photos in the report
   int threads = 0;
 
@@ -216,6 +217,9 @@ struct Options {
       "A frame fails (is recorded, not written) when fewer of its fit vertices than this find the mesh.");
     v("max_median_distance_m", max_median_distance_m,
       "... or when their median distance to the mesh is larger than this, metres.");
+    v("photo_max_side", photo_max_side,
+      "The image terms (landmarks, eyelids, flow) read the photos downsampled by the smallest whole factor that "
+      "brings their longer side to at most this many pixels (0: full size).");
     v("report_overlays", report_overlays, "Frames of each take drawn over the photos in the take's report.");
     v("threads", threads, "Worker threads (0: one per hardware thread).");
   }
