@@ -178,6 +178,10 @@ int main(int argc, char** argv) {
   app.add_option("--voxel-size", voxel_size, "Fusion voxel size in metres (default: the options').");
   app.add_flag("--verbose", verbose, "Log each stage's parts (debug level).");
 #ifdef TEGA_BENCH_HAVE_MVS
+  bool true_masks = false;
+  app.add_flag("--true-masks", true_masks,
+               "Mask the views by the true coverage, as builds without OpenCV (the GPU machine) must, not by the clean "
+               "plate.");
   app.add_option("--config", config, "YAML whose `mvs` section sets the options.");
 #endif
   app.add_option("--poisson-depth", poisson_depth, "Poisson octree depth (default: the options'; needs Open3D).");
@@ -244,7 +248,7 @@ int main(int argc, char** argv) {
 #ifdef TEGA_BENCH_HAVE_MVS
   const mvs::FrameLoader plate_loader(read_take(root / "takes" / "clean_plate"), rig, (root / "rig.json").string());
   const auto plates = plate_loader.load(0, pool);
-  const char* mask_source = "clean plate";
+  const char* mask_source = true_masks ? "true coverage" : "clean plate";
 #else
   const char* mask_source = "true coverage";
 #endif
@@ -257,13 +261,14 @@ int main(int argc, char** argv) {
     auto start = Clock::now();
     prepared.views = loader.load(f, pool);
 #ifdef TEGA_BENCH_HAVE_MVS
-    pool.parallel_for(0, int64_t(prepared.views.size()), [&](int64_t k) {
-      prepared.views[size_t(k)].mask =
-          mvs::subject_mask(prepared.views[size_t(k)].colour, plates[size_t(k)].colour, options.mask);
-    });
-#else
-    mask_from_truth(prepared.views, root, rig, f, pool);
+    if (!true_masks) {
+      pool.parallel_for(0, int64_t(prepared.views.size()), [&](int64_t k) {
+        prepared.views[size_t(k)].mask =
+            mvs::subject_mask(prepared.views[size_t(k)].colour, plates[size_t(k)].colour, options.mask);
+      });
+    } else
 #endif
+      mask_from_truth(prepared.views, root, rig, f, pool);
     prepared.times.load_s = seconds_since(start);
     const std::vector<mvs::ViewTask> tasks = view_tasks(prepared.views, pm);
     start = Clock::now();
