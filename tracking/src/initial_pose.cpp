@@ -19,6 +19,7 @@ constexpr int kRigidIcpIterations = 8;
 constexpr double kRigidIcpStartDistanceM = 0.04;
 constexpr double kFrontFacingCosine = 0.3;
 constexpr double kStartYawsDeg[] = {0, -15, 15, -30, 30};
+constexpr size_t kMinCorrespondences = 50;
 
 // The point closest to all rays (camera centre, unit direction) in the least-squares sense.
 Eigen::Vector3d closest_to_rays(const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>& rays) {
@@ -94,7 +95,8 @@ struct RigidFit {
 };
 
 // Rigid ICP of the neutral head's rigid part, the bound shrinking from a few
-// centimetres to the surface term's first bound.
+// centimetres to the surface term's first bound. `supported` is 0 where the
+// scan met too little of it to fit (a start turned too far, or no head there).
 RigidFit rigid_icp(const HeadModel& model, const Vertices& neutral, const SurfaceQuery& scan, const RigidTransform& start,
                    const Options& options) {
   std::vector<RigidTransform> poses = {start};
@@ -116,12 +118,15 @@ RigidFit rigid_icp(const HeadModel& model, const Vertices& neutral, const Surfac
     problem.iterations = 3 * options.coefficients.solver_iterations;  // once per take
     problem.threads = options.threads;
     supported = problem.frames[0].surface.targets.size();
-    if (supported < 50)
-      throw Error("the scan does not meet the head model near where the head should be (" + std::to_string(supported) +
-                  " correspondences)");
+    if (supported < kMinCorrespondences) return {start, 0};
     fit_coefficients(problem, poses, none);
   }
   return {poses[0], supported};
+}
+
+Error no_head_near() {
+  return Error("the scan does not meet the head model near where the head should be (fewer than " +
+               std::to_string(kMinCorrespondences) + " correspondences)");
 }
 
 }  // namespace
@@ -131,8 +136,11 @@ RigidTransform initial_pose(const HeadModel& model, const Vertices& neutral, con
                             const LandmarkDetector* landmarks) {
   const SurfaceQuery scan(*frame.scan);
   if (landmarks) {
-    if (auto pose = pose_from_landmarks(model, neutral, frame, cameras, *landmarks, options.landmarks.min_views))
-      return rigid_icp(model, neutral, scan, *pose, options).pose;
+    if (auto pose = pose_from_landmarks(model, neutral, frame, cameras, *landmarks, options.landmarks.min_views)) {
+      const RigidFit fit = rigid_icp(model, neutral, scan, *pose, options);
+      if (fit.supported == 0) throw no_head_near();
+      return fit.pose;
+    }
   }
   // The rig only says roughly where the face looks; a head turned away from
   // the rig's centre can pull ICP into a rolled, shifted fit of the brow and
@@ -143,14 +151,15 @@ RigidTransform initial_pose(const HeadModel& model, const Vertices& neutral, con
   for (int v : model.fit_vertices) face += neutral.row(v).cast<double>().transpose();
   const Eigen::Vector3d centre = guess.apply(face / double(model.fit_vertices.size()));
   const Eigen::Vector3d up = guess.R.col(1);
-  std::optional<RigidFit> best;
+  RigidFit best;
   for (const double yaw_deg : kStartYawsDeg) {
     const Eigen::Matrix3d turn = Eigen::AngleAxisd(yaw_deg * M_PI / 180, up).toRotationMatrix();
     const RigidTransform start{turn * guess.R, centre + turn * (guess.t - centre)};
     RigidFit fit = rigid_icp(model, neutral, scan, start, options);
-    if (!best || fit.supported > best->supported) best = std::move(fit);
+    if (fit.supported > best.supported) best = std::move(fit);
   }
-  return best->pose;
+  if (best.supported == 0) throw no_head_near();
+  return best.pose;
 }
 
 }  // namespace tega::tracking
