@@ -4,7 +4,6 @@
 #include <nlohmann/json.hpp>
 
 #include "frame_record.h"
-#include "tega/tracking/photos.h"
 #include "report.h"
 #include "tega/core/error.h"
 #include "tega/core/files.h"
@@ -15,6 +14,7 @@
 #include "tega/core/take.h"
 #include "tega/core/thread_pool.h"
 #include "tega/tracking/landmarks.h"
+#include "tega/tracking/photos.h"
 
 namespace tega::tracking {
 namespace fs = std::filesystem;
