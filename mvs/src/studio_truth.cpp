@@ -1,11 +1,15 @@
 #include "tega/mvs/studio_truth.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
 #include "tega/core/error.h"
 #include "tega/core/files.h"
+#include "tega/core/rig.h"
+#include "tega/synth/ground_truth_depth.h"
 
 namespace tega::mvs {
 namespace {
@@ -28,6 +32,37 @@ std::vector<bool> coarse_face_region(const Mesh& coarse, const nlohmann::json& h
                         normal.z() > 0.1;
   }
   return inside;
+}
+
+// How many of the rig's cameras see each listed face's centroid: in the
+// image, facing the camera, and no more than kDepthTolerance behind the
+// nearest surface there. Depth is rendered at most kMaxSide pixels wide:
+// enough to tell a face from the lips or eyelids that hide it.
+std::vector<int> cameras_seeing(const Mesh& mesh, const std::vector<int>& faces, const Rig& rig) {
+  constexpr double kDepthTolerance = 0.002, kMaxSide = 1024;
+  std::vector<int> seen(faces.size(), 0);
+  for (const Camera& full : rig.cameras) {
+    Camera camera = full.scaled(std::min(1.0, kMaxSide / std::max(full.width, full.height)));
+    camera.distortion = {};
+    const ImageF depth = synth::render_depth(camera, mesh.positions, mesh.faces);
+    const Eigen::Vector3d centre = camera.center();
+    for (size_t i = 0; i < faces.size(); ++i) {
+      const int f = faces[i];
+      const Eigen::Vector3d a = mesh.positions.row(mesh.faces(f, 0)).cast<double>();
+      const Eigen::Vector3d b = mesh.positions.row(mesh.faces(f, 1)).cast<double>();
+      const Eigen::Vector3d c = mesh.positions.row(mesh.faces(f, 2)).cast<double>();
+      const Eigen::Vector3d point = (a + b + c) / 3.0;
+      if ((b - a).cross(c - a).dot(centre - point) <= 0) continue;
+      const auto pixel = camera.project(point);
+      if (!pixel) continue;
+      const int x = int(std::lround(pixel->x())), y = int(std::lround(pixel->y()));
+      if (x < 0 || y < 0 || x >= camera.width || y >= camera.height) continue;
+      const float nearest = depth.at(x, y, 0);
+      const double z = camera.world_to_camera.apply(point).z();
+      if (nearest > 0 && z <= nearest + kDepthTolerance) ++seen[i];
+    }
+  }
+  return seen;
 }
 
 }  // namespace
@@ -55,8 +90,15 @@ StudioTruth load_studio_truth(const std::filesystem::path& capture, const std::s
     throw Error(head_dir / "fine_topology.obj", "does not subdivide template.obj (" +
                                                    std::to_string(truth.fine.num_faces()) + " triangles for " +
                                                    std::to_string(coarse.num_faces()) + ")");
+  std::vector<int> box;
   for (int f = 0; f < truth.fine.num_faces(); ++f)
-    if (region[size_t(f / run)]) truth.face_region.push_back(f);
+    if (region[size_t(f / run)]) box.push_back(f);
+  // The box also holds what no camera can see (a closed mouth's teeth and
+  // socket, the eye sockets behind the eyeballs): stereo needs two views.
+  const Rig rig = read_rig_json(capture / "rig.json");
+  const std::vector<int> seen = cameras_seeing(truth.fine, box, rig);
+  for (size_t i = 0; i < box.size(); ++i)
+    if (seen[i] >= 2) truth.face_region.push_back(box[i]);
   std::vector<char> in_region(size_t(coarse.num_vertices()), 0);
   for (int f = 0; f < coarse.num_faces(); ++f)
     if (region[size_t(f)])
