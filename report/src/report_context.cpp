@@ -49,7 +49,14 @@ RigidTransform calibrated_to_truth_world(const SubjectOutputs& subject) {
   const Rig calibrated = read_rig_json(artifact(*calibrate, "rig"));
   const Rig truth = read_rig_json(subject.truth / "rig.json");
   if (calibrated.cameras.empty() || truth.cameras.empty()) throw Error(artifact(*calibrate, "rig"), "has no cameras");
-  return truth.cameras[0].world_to_camera.inverse() * calibrated.cameras[0].world_to_camera;
+  int shared = 0;
+  for (const Camera& camera : calibrated.cameras) shared += truth.contains(camera.name);
+  if (shared < 3) return truth.cameras[0].world_to_camera.inverse() * calibrated.cameras[0].world_to_camera;
+  try {
+    return align_camera_centres(calibrated, truth);
+  } catch (const Error& e) {
+    throw Error(artifact(*calibrate, "rig"), std::string("cannot be tied to the studio's rig: ") + e.what());
+  }
 }
 
 const fs::path& artifact(const StageOutput& stage, const std::string& name) {

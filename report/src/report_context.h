@@ -51,8 +51,10 @@ std::string verdict(bool met);
 // `count` indices spread evenly over [0, n), first and last included when count >= 2.
 std::vector<size_t> spread(size_t n, size_t count);
 // From the world of the subject's calibrated rig, which later stages' meshes and poses are in, to
-// the studio's truth's: the two are tied by the first camera, as the calibration's score does.
-// The identity where no calibrate stage ran (the stages then used the capture's own rig, the truth's).
+// the studio's truth's: the rigid motion that best carries the calibrated camera centres onto the
+// true ones (align_camera_centres), so that one camera's error is not swung across the head a
+// metre away, as a tie by the first camera would; that tie with fewer than 3 shared cameras. The
+// identity where no calibrate stage ran (the stages then used the capture's own rig, the truth's).
 RigidTransform calibrated_to_truth_world(const SubjectOutputs& subject);
 // The artifact's path; throws tega::Error when the stage's kind provides no such artifact.
 const std::filesystem::path& artifact(const StageOutput& stage, const std::string& name);

@@ -202,9 +202,8 @@ TEST_F(ReportStudio, ZTrackedAndMattedShardsAreShownAndScoredAgainstTheTruth) {
   // Where tracking with the calibrated rig would put them: in its world.
   const Rig calibrated = read_rig_json(workspace() / "calibrate/alice/rig.json");
   const Rig truth = read_rig_json(capture / "rig.json");
-  tracking::write_studio_truth_as_tracked(
-      capture, workspace() / "track/alice/tracked", {},
-      calibrated.cameras[0].world_to_camera.inverse() * truth.cameras[0].world_to_camera);
+  tracking::write_studio_truth_as_tracked(capture, workspace() / "track/alice/tracked", {},
+                                          align_camera_centres(truth, calibrated));
   commit_by_hand(workspace() / "track/alice", "track", "track");
   const fs::path take = workspace() / "matte/alice/mattes/expressions";
   const json cameras = json::parse(read_text_file(capture / "takes/expressions/take.json"))["cameras"];

@@ -36,6 +36,14 @@ struct Rig {
 Rig read_rig_json(const std::filesystem::path& file);
 void write_rig_json(const Rig& rig, const std::filesystem::path& file);
 
+// The rigid motion (no scale: a calibration's scale is metric, and an error
+// in it is an error) that best carries the centres of `from`'s cameras onto
+// those of the same-named cameras of `to`, in least squares. A calibrated
+// rig's world is its own choice; this removes that choice before comparing
+// what was reconstructed in it with the truth. Throws tega::Error unless at
+// least 3 cameras are shared and their centres span a plane.
+RigidTransform align_camera_centres(const Rig& from, const Rig& to);
+
 // A point of a COLMAP sparse model. COLMAP's dense tools (stereo_fusion) find
 // the views that overlap from the points they share.
 struct ColmapPoint {
