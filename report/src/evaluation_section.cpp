@@ -13,9 +13,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::vector<std::pair<std::string, int>> kMetrics = {{"psnr", 2},      {"ssim", 4},        {"l1", 4},
-                                                           {"lpips", 4},     {"psnr_masked", 2}, {"ssim_masked", 4},
-                                                           {"l1_masked", 4}, {"landmark_px", 2}};
+const std::vector<std::pair<std::string, int>> kMetrics = {
+    {"psnr", 2},      {"ssim", 4},           {"l1", 4},
+    {"lpips", 4},     {"psnr_masked", 2},    {"ssim_masked", 4},
+    {"l1_masked", 4}, {"hf_psnr_masked", 2}, {"gradient_error_masked", 4},
+    {"landmark_px", 2}};
 
 // eval.json writes non-finite numbers as strings ("inf", "nan").
 std::string statistic(const nlohmann::json& value, int decimals) {

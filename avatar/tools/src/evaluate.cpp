@@ -19,8 +19,10 @@ namespace tega::tools {
 namespace fs = std::filesystem;
 
 const std::vector<std::string>& metric_names() {
-  static const std::vector<std::string> names{"landmark_px", "lpips",       "ssim",       "psnr",
-                                              "l1",          "ssim_masked", "psnr_masked", "l1_masked"};
+  static const std::vector<std::string> names{"landmark_px",    "lpips",      "ssim",
+                                              "psnr",           "l1",         "ssim_masked",
+                                              "psnr_masked",    "l1_masked",  "hf_psnr_masked",
+                                              "gradient_error_masked"};
   return names;
 }
 
@@ -89,6 +91,8 @@ std::vector<SplitResult> evaluate_avatar(trainer::TrainedAvatar& avatar, const D
       v.metrics["psnr_masked"] = psnr(rendered, target, mask);
       v.metrics["ssim_masked"] = ssim(rendered, target, mask);
       v.metrics["l1_masked"] = l1(rendered, target, mask);
+      v.metrics["hf_psnr_masked"] = hf_psnr(rendered, target, mask);
+      v.metrics["gradient_error_masked"] = gradient_error(rendered, target, mask);
       if (lpips_here) v.metrics["lpips"] = (*lpips_here)(rendered, target);
       if (landmarks) v.metrics["landmark_px"] = landmark_error_px(reference_landmarks, avatar_landmarks, camera);
       result.views.push_back(std::move(v));
@@ -116,6 +120,12 @@ EvalNotes evaluation_notes(const Dataset& dataset, bool lpips) {
 }
 
 namespace {
+
+const char* const kDetailNote =
+    "hf_psnr_masked: PSNR (peak 1) of the high-frequency band, the image minus its Gaussian blur (sigma 1.5 px); "
+    "gradient_error_masked: mean absolute difference of the per-channel Sobel gradient magnitudes (intensity per "
+    "pixel). Both inside the head mask: they score the fine detail (wrinkles, hair, sharp edges) that LPIPS and "
+    "close-ups show and PSNR barely weighs";
 
 nlohmann::json number(double v) {
   if (std::isnan(v)) return "nan";
@@ -151,6 +161,21 @@ const SplitResult* find_split(const ModelResult& model, const std::string& name)
   return nullptr;
 }
 
+struct MetricColumn {
+  const char* title;
+  int digits;
+};
+
+MetricColumn metric_column(const std::string& metric) {
+  static const std::map<std::string, MetricColumn> columns{
+      {"landmark_px", {"Landmark px ↓", 1}},  {"lpips", {"LPIPS ↓", 3}},
+      {"ssim", {"SSIM ↑", 3}},                {"psnr", {"PSNR ↑", 2}},
+      {"l1", {"L1 ↓", 4}},                    {"ssim_masked", {"SSIM ↑", 3}},
+      {"psnr_masked", {"PSNR ↑", 2}},         {"l1_masked", {"L1 ↓", 4}},
+      {"hf_psnr_masked", {"HF PSNR ↑", 2}},   {"gradient_error_masked", {"Gradient error ↓", 4}}};
+  return columns.at(metric);
+}
+
 std::string cell(const SplitResult* split, const std::string& metric) {
   if (!split) return "—";
   std::vector<double> values;
@@ -161,7 +186,7 @@ std::string cell(const SplitResult* split, const std::string& metric) {
   const auto fmt = [&](double x) -> std::string {
     if (std::isnan(x)) return "nan";
     if (std::isinf(x)) return x > 0 ? "∞" : "-∞";
-    const int digits = metric.rfind("psnr", 0) == 0 ? 2 : metric == "landmark_px" ? 1 : metric.rfind("l1", 0) == 0 ? 4 : 3;
+    const int digits = metric_column(metric).digits;
     char text[64];
     std::snprintf(text, sizeof text, "%.*f", digits, x);
     return text;
@@ -175,13 +200,6 @@ std::string split_title(const std::string& name) {
   return "Train views";
 }
 
-const char* metric_title(const std::string& metric) {
-  static const std::map<std::string, const char*> titles{
-      {"landmark_px", "Landmark px ↓"}, {"lpips", "LPIPS ↓"},        {"ssim", "SSIM ↑"},      {"psnr", "PSNR ↑"},
-      {"l1", "L1 ↓"},                   {"ssim_masked", "SSIM ↑"}, {"psnr_masked", "PSNR ↑"}, {"l1_masked", "L1 ↓"}};
-  return titles.at(metric);
-}
-
 std::string table(const std::vector<ModelResult>& models, const std::vector<std::string>& metrics) {
   std::vector<std::string> split_names;
   for (const auto& m : models)
@@ -190,7 +208,7 @@ std::string table(const std::vector<ModelResult>& models, const std::vector<std:
   std::string header = "| model |", rule = "| --- |";
   for (const auto& split : split_names)
     for (const auto& metric : metrics) {
-      header += " " + split_title(split) + " " + metric_title(metric) + " |";
+      header += " " + split_title(split) + " " + metric_column(metric).title + " |";
       rule += " --- |";
     }
   std::string out = header + "\n" + rule + "\n";
@@ -210,6 +228,7 @@ nlohmann::json evaluation_json(const std::vector<ModelResult>& models, const Eva
   doc["notes"] = {{"lpips", notes.lpips.empty() ? "evaluated (lpips vgg v0.1)" : notes.lpips},
                   {"landmarks", notes.landmarks},
                   {"masked", "*_masked metrics are computed inside the head mask: the dataset image's alpha > 0.5"},
+                  {"detail", kDetailNote},
                   {"statistics", "mean and population standard deviation over views; NaN values (an empty mask) are "
                                  "counted under 'undefined' and left out"}};
   for (const auto& m : models) {
@@ -241,10 +260,11 @@ std::string evaluation_markdown(const std::vector<ModelResult>& models, const Ev
          "held-out cameras. Mean ± std over views.\n\n## Full image\n\n";
   out += table(models, {"landmark_px", "lpips", "ssim", "psnr", "l1"});
   out += "\n## Inside the head mask (alpha > 0.5)\n\n";
-  out += table(models, {"ssim_masked", "psnr_masked", "l1_masked"});
+  out += table(models, {"ssim_masked", "psnr_masked", "l1_masked", "hf_psnr_masked", "gradient_error_masked"});
   out += "\n";
   if (!notes.lpips.empty()) out += "- " + notes.lpips + "\n";
   out += "- " + notes.landmarks + "\n";
+  out += std::string("- ") + kDetailNote + "\n";
   return out;
 }
 

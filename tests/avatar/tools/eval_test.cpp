@@ -53,6 +53,10 @@ TEST(Eval, ScoresTheViewsOfThePapersProtocol) {
     EXPECT_NEAR(v.metrics.at("psnr"), psnr(rendered, target), 1e-9);
     EXPECT_NEAR(v.metrics.at("l1"), l1(rendered, target), 1e-9);
     EXPECT_NEAR(v.metrics.at("ssim"), ssim(rendered, target), 1e-9);
+    const at::Tensor everywhere = at::ones({rendered.size(1), rendered.size(2)}, at::kBool);
+    EXPECT_NEAR(v.metrics.at("hf_psnr_masked"), hf_psnr(rendered, target, everywhere), 1e-9);
+    EXPECT_NEAR(v.metrics.at("gradient_error_masked"), gradient_error(rendered, target, everywhere), 1e-9);
+    EXPECT_GT(v.metrics.at("gradient_error_masked"), 0.0);
     // The tiny dataset's matte is opaque everywhere: masked = full.
     EXPECT_NEAR(v.metrics.at("psnr_masked"), v.metrics.at("psnr"), 1e-9);
     EXPECT_EQ(v.metrics.count("lpips"), 0u);
@@ -116,6 +120,11 @@ TEST(Eval, JsonAndMarkdownHoldStatisticsNotesAndInfinity) {
   EXPECT_TRUE(ours["novel_view"]["per_camera"].contains("cam01"));
   EXPECT_EQ(ours["novel_view"]["per_view"][0]["frame"], "smile_000000");
   EXPECT_FALSE(ours["reenactment"]["metrics"].contains("lpips"));
+  for (const char* detail : {"hf_psnr_masked", "gradient_error_masked"}) {
+    EXPECT_NEAR(ours["novel_view"]["metrics"][detail]["mean"].get<double>(),
+                model.splits[1].views[0].metrics.at(detail), 1e-9);
+    EXPECT_NE(doc["notes"]["detail"].get<std::string>().find(detail), std::string::npos);
+  }
   const auto& perfect_json = doc["models"][1]["splits"]["reenactment"]["metrics"];
   EXPECT_EQ(perfect_json["psnr"]["mean"], "inf");
   EXPECT_EQ(perfect_json["psnr"]["std"], "nan");
@@ -126,6 +135,8 @@ TEST(Eval, JsonAndMarkdownHoldStatisticsNotesAndInfinity) {
   EXPECT_NE(markdown.find("| Perfect |"), std::string::npos) << markdown;
   EXPECT_NE(markdown.find("Test reenactment PSNR ↑"), std::string::npos) << markdown;
   EXPECT_NE(markdown.find("Novel view SSIM ↑"), std::string::npos) << markdown;
+  EXPECT_NE(markdown.find("Test reenactment HF PSNR ↑"), std::string::npos) << markdown;
+  EXPECT_NE(markdown.find("Novel view Gradient error ↓"), std::string::npos) << markdown;
   EXPECT_NE(markdown.find("∞ ± nan"), std::string::npos) << markdown;
   char psnr_text[32];
   std::snprintf(psnr_text, sizeof psnr_text, "%.2f ± 0.00", psnr_value);

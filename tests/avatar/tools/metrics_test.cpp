@@ -70,6 +70,116 @@ TEST(Metrics, MaskedMetricsSeeOnlyTheMask) {
   EXPECT_TRUE(std::isnan(psnr(a, b, at::zeros({48, 64}, at::kBool))));  // an empty mask
 }
 
+// A Gaussian blur (σ in pixels, edge-replicated) of a [C,H,W] image: the
+// render that lost its fine detail.
+at::Tensor blurred(const at::Tensor& image, double sigma) {
+  const int64_t r = static_cast<int64_t>(std::ceil(3 * sigma));
+  const at::Tensor x = at::arange(-r, r + 1, at::kDouble);
+  at::Tensor g = at::exp(-x.square() / (2 * sigma * sigma));
+  g = (g / g.sum()).to(image.scalar_type());
+  const at::Tensor padded = at::replication_pad2d(image.unsqueeze(1), {r, r, r, r});
+  return at::conv2d(at::conv2d(padded, g.view({1, 1, -1, 1})), g.view({1, 1, 1, -1})).squeeze(1);
+}
+
+at::Tensor full_mask() { return at::ones({48, 64}, at::kBool); }
+
+TEST(Metrics, DetailMetricsOfIdenticalImagesAndOfAConstantOffset) {
+  const at::Tensor a = test_image();
+  EXPECT_EQ(gradient_error(a, a, full_mask()), 0.0);
+  EXPECT_TRUE(std::isinf(hf_psnr(a, a, full_mask())) && hf_psnr(a, a, full_mask()) > 0);
+  // A uniform brightness error is no detail error (the border is replicated,
+  // not zero-padded, so it stays uniform up to the frame's edge). What is
+  // left is the float32 rounding of a + 0.05 (~1e-9).
+  const at::Tensor brighter = a + 0.05;
+  EXPECT_NEAR(psnr(a, brighter, full_mask()), 26.02, 0.01);
+  EXPECT_LT(gradient_error(a, brighter, full_mask()), 1e-7);
+  EXPECT_GT(hf_psnr(a, brighter, full_mask()), 120.0);
+}
+
+TEST(Metrics, BlurScoresFarWorseOnDetailThanAShadingErrorOfEqualPsnr) {
+  const at::Tensor truth = test_image();
+  const at::Tensor mask = full_mask();
+  const at::Tensor blurry = blurred(truth, 1.0);
+  // A smooth shading error (one slow wave across the head) scaled to the
+  // blurred render's masked MSE: plain PSNR cannot tell the two apart.
+  const at::Tensor x = at::linspace(0, 1, 64).view({1, 1, 64}), y = at::linspace(0, 1, 48).view({1, 48, 1});
+  const at::Tensor wave = at::sin(3.0 * x + 2.0 * y).expand({3, 48, 64});
+  const double target_mse = (blurry - truth).square().mean().item<double>();
+  const at::Tensor shaded = truth + wave * std::sqrt(target_mse / wave.square().mean().item<double>());
+  ASSERT_NEAR(psnr(blurry, truth, mask), psnr(shaded, truth, mask), 1e-4);
+  // Both 31.99 dB; HF PSNR 32.11 (blurry) against 73.47 dB, gradient error
+  // 0.0080 against 0.0009.
+  EXPECT_GT(hf_psnr(shaded, truth, mask) - hf_psnr(blurry, truth, mask), 15.0);
+  EXPECT_GT(gradient_error(blurry, truth, mask), 5 * gradient_error(shaded, truth, mask));
+  // The blur's error is nearly all detail: its HF-band PSNR is close to its
+  // plain PSNR, and over the whole image not below it (the band's gain is at
+  // most 1 at every frequency).
+  EXPECT_GE(hf_psnr(blurry, truth, mask), psnr(blurry, truth, mask));
+  EXPECT_LT(hf_psnr(blurry, truth, mask), psnr(blurry, truth, mask) + 2.0);
+  // More blur, more detail lost, on both metrics.
+  const at::Tensor blurrier = blurred(truth, 2.0);
+  EXPECT_LT(hf_psnr(blurrier, truth, mask), hf_psnr(blurry, truth, mask));
+  EXPECT_GT(gradient_error(blurrier, truth, mask), gradient_error(blurry, truth, mask));
+}
+
+TEST(Metrics, HfPsnrKeepsTheFinestDetailWhole) {
+  // A ±d checkerboard error is all high frequency: the σ = 1.5 blur removes
+  // it almost entirely, so its band PSNR is its plain PSNR, -20 log10 d.
+  // Scored 5 px (the blur's radius) inside the frame, whose replicated
+  // border breaks the pattern.
+  const at::Tensor a = test_image();
+  const at::Tensor parity = (at::arange(48).view({48, 1}) + at::arange(64).view({1, 64})).remainder(2);
+  const at::Tensor checker = (parity.to(at::kFloat) * 2 - 1).expand({3, 48, 64});
+  const at::Tensor inner = at::zeros({48, 64}, at::kBool);
+  inner.slice(0, 5, 43).slice(1, 5, 59).fill_(true);
+  const double d = 0.02;
+  EXPECT_NEAR(hf_psnr(a, a + d * checker, inner), -20 * std::log10(d), 0.01);  // 33.98 dB
+  EXPECT_NEAR(psnr(a, a + d * checker, inner), -20 * std::log10(d), 1e-4);
+}
+
+TEST(Metrics, GradientErrorOfAScaledStepEdge) {
+  // A vertical step of height h between columns 19 and 20; the render's step
+  // is k·h. The Sobel magnitude (kernels /8) of a step is h/2 on each of the
+  // two columns beside it, on every row (the replicated border continues the
+  // edge), and 0 elsewhere: the error is |k - 1|·h/2 on those two columns.
+  const double h = 0.4, k = 0.25;
+  const auto step = [](double height) {
+    at::Tensor image = at::full({3, 48, 64}, 0.2);
+    image.slice(2, 20).add_(height);
+    return image;
+  };
+  const at::Tensor truth = step(h), render = step(k * h);
+  const double per_edge_pixel = (1 - k) * h / 2;  // 0.15
+  EXPECT_NEAR(gradient_error(render, truth, full_mask()), 2 * per_edge_pixel / 64, 1e-7);
+  at::Tensor band = at::zeros({48, 64}, at::kBool);
+  band.slice(1, 10, 30).fill_(true);  // 20 columns around the edge
+  EXPECT_NEAR(gradient_error(render, truth, band), 2 * per_edge_pixel / 20, 1e-7);
+  at::Tensor beside = at::zeros({48, 64}, at::kBool);
+  beside.slice(1, 19, 20).fill_(true);
+  EXPECT_NEAR(gradient_error(render, truth, beside), per_edge_pixel, 1e-7);
+  // The magnitude has no sign: an edge stepping down by h scores as one stepping up.
+  EXPECT_NEAR(gradient_error(step(-h), truth, full_mask()), 0.0, 1e-7);
+}
+
+TEST(Metrics, DetailMetricsSeeOnlyTheMask) {
+  const at::Tensor a = test_image();
+  at::Tensor b = a.clone();
+  b.slice(1, 24).copy_(blurred(a, 1.5).slice(1, 24));  // blur only the bottom half
+  // The top mask ends 6 rows above the damage, beyond both filters' reach (5 px).
+  const at::Tensor top = at::zeros({48, 64}, at::kBool), bottom = at::zeros({48, 64}, at::kBool);
+  top.slice(0, 0, 18).fill_(true);
+  bottom.slice(0, 24).fill_(true);
+  EXPECT_EQ(gradient_error(a, b, top), 0.0);
+  EXPECT_TRUE(std::isinf(hf_psnr(a, b, top)));
+  EXPECT_GT(gradient_error(a, b, bottom), 0.005);
+  EXPECT_LT(hf_psnr(a, b, bottom), 40.0);
+  // Over the whole image the same damage is spread over twice the pixels.
+  EXPECT_LT(gradient_error(a, b, full_mask()), gradient_error(a, b, bottom));
+  EXPECT_GT(hf_psnr(a, b, full_mask()), hf_psnr(a, b, bottom));
+  EXPECT_TRUE(std::isnan(gradient_error(a, b, at::zeros({48, 64}, at::kBool))));  // an empty mask
+  EXPECT_TRUE(std::isnan(hf_psnr(a, b, at::zeros({48, 64}, at::kBool))));
+}
+
 TEST(Metrics, StatisticsHandleInfinityAndUndefinedValues) {
   const Statistics s = statistics({20.0, 22.0, 24.0});
   EXPECT_DOUBLE_EQ(s.mean, 22.0);

@@ -8,8 +8,9 @@
 //
 // Every view is rendered at the dataset's resolution and compared with its
 // image composited over the run's background: PSNR, SSIM and L1 on the full
-// image and inside the head mask (alpha > 0.5), LPIPS when weights are
-// given, and the landmark error (landmarks.h) when the dataset defines
+// image and inside the head mask (alpha > 0.5), the detail metrics of
+// metrics.h inside the mask, LPIPS when weights are given, and the landmark
+// error (landmarks.h) when the dataset defines
 // landmark vertices. Results: mean ± std per split, per camera and per frame,
 // and every view, as JSON, plus a Markdown table like the paper's Table 1.
 

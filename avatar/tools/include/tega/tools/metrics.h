@@ -7,6 +7,23 @@
 //    padding, C1 = 0.01², C2 = 0.03²). Masked: the mean of the SSIM map over
 //    the mask's pixels (the windows still see the whole image).
 //  - L1 = mean absolute difference over all channels.
+//  - Two detail metrics stand in for LPIPS, which needs weights that tega
+//    cannot ship: PSNR and L1 barely move when a render loses its fine
+//    detail (wrinkles, stubble, eyelashes: a small part of the error energy),
+//    while LPIPS and the paper's close-ups (TeGA §5, Figs. 6-7) show exactly
+//    that. Both compute their filters over the whole image (edge-replicated
+//    border, so the frame's edge is no edge) and average over the mask, so
+//    the silhouette's sharpness counts as in ssim_masked.
+//     - gradient_error: per channel, the Sobel gradient magnitude (kernels
+//       /8: a ramp of slope s per pixel has magnitude s); the mean absolute
+//       difference of the two images' magnitudes. Blur flattens edges, so
+//       it lowers the render's magnitudes where the truth's are high.
+//     - hf_psnr: the PSNR (peak 1, as psnr) of the high-frequency band, the
+//       image minus its Gaussian blur (σ = 1.5 px, the SSIM window). The
+//       band is linear, so only the difference's fine part counts: a smooth
+//       shading or colour error scores near +inf, a blurred render about its
+//       plain PSNR; the gap hf_psnr - psnr says how much of the error is not
+//       detail.
 // Masked values are NaN when the mask is empty.
 
 #include <ATen/ATen.h>
@@ -25,6 +42,8 @@ double ssim(const at::Tensor& a, const at::Tensor& b);
 double ssim(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask);
 double l1(const at::Tensor& a, const at::Tensor& b);
 double l1(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask);
+double gradient_error(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask);
+double hf_psnr(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask);
 
 // Mean and (population) standard deviation of the finite-or-infinite values
 // given; NaN values (e.g. masked metrics of an empty mask) are left out and
