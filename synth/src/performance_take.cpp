@@ -4,6 +4,9 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "studio.h"
 #include "tega/core/files.h"
 #include "tega/synth/performance.h"
@@ -17,12 +20,14 @@ struct FrameGeometry {
   RigidTransform head_to_world;
   Vertices coarse;  // world
   FineFrame fine;   // world
+  RigidTransform dataset_pose;     // the dataset's head_to_world (lagged with tracking_error.lag_pose)
+  nlohmann::json tracking_error;   // what the tracking-error model did (when it is on)
 };
 
 }  // namespace
 
 void render_performance(const Studio& studio, const std::string& take, const Dataset& dataset,
-                        std::vector<DatasetFrame>& dataset_frames) {
+                        std::vector<DatasetFrame>& dataset_frames, nlohmann::json& tracking_error_frames) {
   const Options& o = studio.options;
   const BlendshapeModel& model = studio.head.model;
   const std::vector<PerformanceFrame> script = perform(take, o.frames, uint64_t(o.seed));
@@ -35,6 +40,15 @@ void render_performance(const Studio& studio, const std::string& take, const Dat
     if (index >= 0) channels.emplace_back(i, index);
     else spdlog::warn("synth: the head model has no expression '{}'; take {} goes without it", name, take);
   }
+
+  std::vector<int> driven;  // model expressions the script sets
+  for (const auto& [channel, index] : channels) driven.push_back(index);
+  const auto script_expression = [&](int f) {
+    std::vector<float> e(model.expression_names.size(), 0.0f);
+    for (const auto& [channel, index] : channels) e[index] = script[f].expression[channel].second;
+    return e;
+  };
+  const TrackingError& errors = studio.tracking_error;
 
   const auto& cameras = studio.rig.cameras;
   const int n_cameras = static_cast<int>(cameras.size());
@@ -59,15 +73,50 @@ void render_performance(const Studio& studio, const std::string& take, const Dat
     studio.pool.parallel_for(0, count, [&](int64_t i) {
       const int f = first + static_cast<int>(i);
       FrameGeometry& g = geometry[i];
-      g.expression.assign(model.expression_names.size(), 0.0f);
-      for (const auto& [channel, index] : channels) g.expression[index] = script[f].expression[channel].second;
+      g.expression = script_expression(f);
       g.head_to_world = script[f].motion * pivot_to_origin;
+      g.dataset_pose = g.head_to_world;
       g.coarse = model.evaluate({}, g.expression, g.head_to_world);
       g.fine = studio.maker.make(g.coarse, g.expression);
       const std::string id = take + "_" + frame_name(f);
       write_vertices_bin(g.coarse, gt / "coarse" / (frame_name(f) + ".bin"));
       if (o.write_fine_meshes) write_vertices_bin(g.fine.positions, gt / "fine" / (frame_name(f) + ".bin"));
-      write_vertices_bin(g.coarse, dataset.mesh_path(id));
+      if (!errors.enabled()) {
+        write_vertices_bin(g.coarse, dataset.mesh_path(id));
+        return;
+      }
+      // The dataset's mesh as a tracker would have it: lagged, misfit, offset.
+      const TrackingError::LagSource lag = errors.lag_source(f, o.frames);
+      std::vector<float> lagged = script_expression(lag.first);
+      if (lag.weight > 0) {
+        const std::vector<float> next = script_expression(lag.second);
+        for (size_t e = 0; e < lagged.size(); ++e)
+          lagged[e] = static_cast<float>((1 - lag.weight) * lagged[e] + lag.weight * next[e]);
+      }
+      const std::vector<float> expression = errors.misfit(lagged, driven, take, f);
+      if (errors.options().lag_pose)
+        g.dataset_pose = interpolate_pose(script[lag.first].motion, script[lag.second].motion, lag.weight) *
+                         pivot_to_origin;
+      Vertices mesh = model.evaluate({}, expression, g.dataset_pose);
+      double rms = 0, largest = 0;
+      if (errors.options().offset_m > 0) {
+        const Vertices offset = errors.offset(take, f);  // head space
+        mesh += (offset.cast<double>() * g.dataset_pose.R.transpose()).cast<float>();
+        rms = errors.skin_rms(offset);
+        largest = errors.skin_max(offset);
+      }
+      write_vertices_bin(mesh, dataset.mesh_path(id));
+      nlohmann::json coefficients = nlohmann::json::object();
+      for (size_t e = 0; e < expression.size(); ++e)
+        if (expression[e] != g.expression[e] || std::find(driven.begin(), driven.end(), int(e)) != driven.end())
+          coefficients[model.expression_names[e]] = expression[e];
+      g.tracking_error = {{"id", id},
+                          {"lag_source", {lag.first, lag.second}},
+                          {"lag_weight", lag.weight},
+                          {"expression", coefficients},
+                          {"head_to_world", pose_json(g.dataset_pose)},
+                          {"offset_rms_m", rms},     // over the skin (non-eyeball) vertices
+                          {"offset_max_m", largest}};
     });
 
     studio.pool.parallel_for(0, int64_t(count) * n_cameras, [&](int64_t task) {
@@ -101,7 +150,8 @@ void render_performance(const Studio& studio, const std::string& take, const Dat
                              {"expression", expression},
                              {"wrinkles", wrinkles},
                              {"head_to_world", pose_json(g.head_to_world)}});
-      dataset_frames.push_back({take + "_" + frame_name(f), take, g.head_to_world});
+      dataset_frames.push_back({take + "_" + frame_name(f), take, g.dataset_pose});
+      if (errors.enabled()) tracking_error_frames.push_back(g.tracking_error);
     }
   }
 

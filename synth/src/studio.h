@@ -16,6 +16,7 @@
 #include "tega/synth/backdrop.h"
 #include "tega/synth/fine_mesh.h"
 #include "tega/synth/options.h"
+#include "tega/synth/tracking_error.h"
 
 namespace tega::synth {
 
@@ -32,6 +33,7 @@ struct Studio {
   const std::vector<PinholeLookup>& lens;  // per camera
   ThreadPool& pool;
   Progress& progress;
+  const TrackingError& tracking_error;  // of the dataset's meshes
 };
 
 // `foreground`: premultiplied RGBA from rasterize(). Sensor noise is a pure
@@ -50,8 +52,9 @@ void write_take_json(const Studio& studio, const std::string& take, const std::s
 void render_clean_plate(const Studio& studio);
 void render_calibration(const Studio& studio, const std::string& take);
 // Appends the take's frames to `dataset_frames` (their meshes and matted
-// images are written under `dataset`).
+// images are written under `dataset`) and, when the tracking-error model is
+// on, what it did to each frame's mesh to `tracking_error_frames`.
 void render_performance(const Studio& studio, const std::string& take, const Dataset& dataset,
-                        std::vector<DatasetFrame>& dataset_frames);
+                        std::vector<DatasetFrame>& dataset_frames, nlohmann::json& tracking_error_frames);
 
 }  // namespace tega::synth

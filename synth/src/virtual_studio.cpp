@@ -14,6 +14,7 @@
 #include "tega/synth/charuco_board.h"
 #include "tega/synth/performance.h"
 #include "tega/synth/studio_rig.h"
+#include "tega/synth/tracking_error.h"
 
 namespace tega::synth {
 namespace {
@@ -73,6 +74,7 @@ void validate_options(const Options& o) {
   if (o.test_takes.size() >= o.takes.size()) throw Error("test_takes must leave at least one take for training");
   if (o.noise_sigma < 0 || o.wrinkle_depth_m < 0 || o.crease_darkening < 0)
     throw Error("noise_sigma, wrinkle_depth_m and crease_darkening must not be negative");
+  validate_tracking_error_options(o.tracking_error);
 }
 
 Head make_head(const Options& o) {
@@ -99,6 +101,7 @@ SynthSummary render_virtual_studio(const Options& o, const std::filesystem::path
   const Appearance appearance(uint64_t(o.seed));
   const Backdrop backdrop(uint64_t(o.seed));
   const HeadShader shader(head, maker, appearance);
+  const TrackingError tracking_error(head, o.tracking_error, uint64_t(o.seed));
   ThreadPool pool(o.threads);
   spdlog::info("synth: {} head ({} vertices, {} fine triangles), {} cameras at {}x{}", head.source,
                head.model.num_vertices(), maker.fine_topology().num_faces(), rig.cameras.size(), o.studio.width,
@@ -118,7 +121,8 @@ SynthSummary render_virtual_studio(const Options& o, const std::filesystem::path
     backgrounds[c] = backdrop.render(rig.cameras[c]);
     lens[c] = pinhole_lookup(rig.cameras[c]);
   });
-  const Studio studio{o, root, truth, head, maker, rig, appearance, shader, backgrounds, lens, pool, progress};
+  const Studio studio{o,           root, truth, head, maker,    rig,     appearance,
+                      shader,      backgrounds, lens, pool, progress, tracking_error};
 
   write_rig_json(rig, truth / "rig.json");
   write_head_ground_truth(truth / "ground_truth" / "head", head, maker);
@@ -144,9 +148,10 @@ SynthSummary render_virtual_studio(const Options& o, const std::filesystem::path
   for (Camera& cam : dataset.rig.cameras) cam.distortion = {};  // its images are undistorted
   dataset.template_mesh = head.model.neutral;
   dataset.eyeball_faces = head.eyeball_faces;
+  nlohmann::json tracking_error_frames = nlohmann::json::array();
   for (const auto& take : o.takes) {
     std::vector<DatasetFrame> frames;
-    render_performance(studio, take, dataset, frames);
+    render_performance(studio, take, dataset, frames, tracking_error_frames);
     const bool test = std::find(o.test_takes.begin(), o.test_takes.end(), take) != o.test_takes.end();
     for (const auto& f : frames) (test ? dataset.test : dataset.train).frames.push_back(f.id);
     dataset.frames.insert(dataset.frames.end(), frames.begin(), frames.end());
@@ -158,6 +163,24 @@ SynthSummary render_virtual_studio(const Options& o, const std::filesystem::path
         n_cameras == 1)
       dataset.train.cameras.push_back(name);
   write_dataset_manifest(dataset);
+  // The dataset's meshes are not the truth: say so beside them, and in capture.json.
+  nlohmann::json tracking_error_json;
+  if (tracking_error.enabled()) {
+    const TrackingErrorOptions& t = o.tracking_error;
+    tracking_error_json = {{"offset_m", t.offset_m},           {"offset_scale", t.offset_scale},
+                           {"offset_bumps", t.offset_bumps},   {"period_frames", t.period_frames},
+                           {"lag", t.lag},                     {"lag_pose", t.lag_pose},
+                           {"eyelid_misfit", t.eyelid_misfit}, {"eyelid_gain", t.eyelid_gain},
+                           {"lip_misfit", t.lip_misfit},       {"lip_gain", t.lip_gain}};
+    write_text_atomic(dataset.root / "tracking_error.json",
+                      nlohmann::json{{"note", "meshes/ are perturbed by tega synth's tracking-error model "
+                                              "(docs/virtual-studio.md#tracking-errors); the images and "
+                                              "ground_truth/ are the true head's"},
+                                     {"seed", o.seed},
+                                     {"options", tracking_error_json},
+                                     {"frames", tracking_error_frames}}
+                              .dump(2) + "\n");
+  }
   progress.finish();
 
   nlohmann::json takes = nlohmann::json::array();
@@ -174,6 +197,9 @@ SynthSummary render_virtual_studio(const Options& o, const std::filesystem::path
       {"takes", takes},
       {"calibration_skipped", summary.calibration_skipped},
       {"options", options_to_yaml(o)}};
+  if (tracking_error.enabled())
+    capture.update({{"dataset_meshes", "perturbed by tracking_error (dataset/tracking_error.json)"},
+                    {"tracking_error", tracking_error_json}});
   // A raw capture names no rig: a stage that is not given the calibrated one
   // fails on the missing rig.json instead of reading the truth.
   if (!o.truth_apart) capture.update({{"rig", "rig.json"}, {"ground_truth", "ground_truth"}, {"dataset", "dataset"}});

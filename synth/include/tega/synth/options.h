@@ -41,6 +41,68 @@ struct StudioOptions {
   }
 };
 
+// Tracking errors written into the dataset's meshes only (dataset/meshes):
+// the images, ground_truth/ and the dataset's images stay those of the true
+// head, so an avatar trained on the dataset meets the errors a real tracked
+// mesh has. Everything is off by default (the dataset's meshes are then the
+// true coarse meshes, byte for byte). Applied in this order: lag, misfit (to
+// the expression coefficients), then the offset field (to the mesh).
+// docs/virtual-studio.md#tracking-errors says what each models.
+struct TrackingErrorOptions {
+  double offset_m = 0.0;
+  double offset_scale = 1.0;
+  int offset_bumps = 6;
+  int period_frames = 1;
+  double lag = 0.0;
+  bool lag_pose = false;
+  double eyelid_misfit = 0.0;
+  double eyelid_gain = 1.0;
+  double lip_misfit = 0.0;
+  double lip_gain = 1.0;
+
+  // Whether any of the errors changes a mesh.
+  bool enabled() const {
+    return offset_m != 0 || lag != 0 || eyelid_misfit != 0 || eyelid_gain != 1 || lip_misfit != 0 ||
+           lip_gain != 1;
+  }
+
+  template <class V>
+  void visit(V& v) {
+    v("offset_m", offset_m,
+      "RMS, metres, over the skin (non-eyeball) vertices, of a smooth displacement field added to every "
+      "frame's dataset mesh (0 = none): a sum of offset_bumps Gaussian bumps in the face frame, each "
+      "with a random 3D direction, scaled to exactly this RMS in every frame; each eyeball moves "
+      "rigidly with the field at its centre.");
+    v("offset_scale", offset_scale,
+      "Standard deviation of each bump of the offset field, in interocular distances (1 = about 6 cm): "
+      "the field's wavelength.");
+    v("offset_bumps", offset_bumps, "Number of Gaussian bumps in the offset field (1 or more).");
+    v("period_frames", period_frames,
+      "Frames between independent draws of the random errors (offset field, misfit errors): 1 = a new, "
+      "independent draw every frame; N > 1 = draws at frames 0, N, 2N, ... of each take, blended "
+      "smoothly in between (temporally correlated error).");
+    v("lag", lag,
+      "Temporal lag, frames (fractional allowed, 0 = none): the dataset mesh of frame t uses the "
+      "expression of frame t - lag, linearly interpolated between frames, clamped at the take's first frame.");
+    v("lag_pose", lag_pose,
+      "Lag the rigid head pose too (interpolated by slerp; the dataset's head_to_world follows it); "
+      "false = only the expression lags.");
+    v("eyelid_misfit", eyelid_misfit,
+      "Largest random error added to eyeBlink_L and eyeBlink_R (coefficient units, 0 = none): each eye "
+      "gets its own uniform draw in [-eyelid_misfit, eyelid_misfit]; the result is clamped to [0, 1].");
+    v("eyelid_gain", eyelid_gain,
+      "Factor on eyeBlink_L and eyeBlink_R before the misfit error (1 = none; < 1: blinks that never "
+      "quite close in the meshes).");
+    v("lip_misfit", lip_misfit,
+      "Largest random error added to each jaw* and mouth* expression the performance drives "
+      "(coefficient units, 0 = none): a uniform draw per expression in [-lip_misfit, lip_misfit]; the "
+      "result is clamped to [0, 1].");
+    v("lip_gain", lip_gain,
+      "Factor on the jaw* and mouth* expressions before the misfit error (1 = none; < 1: mouth shapes "
+      "that the meshes under-state).");
+  }
+};
+
 struct Options {
   StudioOptions studio;
   int frames = 30;
@@ -62,6 +124,7 @@ struct Options {
   double noise_sigma = 0.004;
   bool write_fine_meshes = true;
   bool truth_apart = false;
+  TrackingErrorOptions tracking_error;
   int threads = 0;
 
   template <class V>
@@ -102,6 +165,9 @@ struct Options {
       "Write the ground truth (the true rig.json, ground_truth/ and dataset/) into the sibling directory "
       "OUT.truth/ instead of into the capture OUT/, which then holds only what a capture session records "
       "(capture.json and takes/, no rig): a raw capture whose later stages cannot read the truth.");
+    v("tracking_error", tracking_error,
+      "Tracking errors in the dataset's meshes only (dataset/meshes; never the images or ground_truth/); "
+      "all off by default.");
     v("threads", threads, "Worker threads; 0 = one per hardware thread.");
   }
 };
