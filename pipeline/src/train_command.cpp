@@ -13,6 +13,7 @@ namespace {
 struct TrainArguments {
   std::string data, out, config;
   std::vector<std::string> overrides, ablations;
+  std::string baseline;
   std::optional<int64_t> iterations;
   int64_t stop_at = 0;
   std::optional<std::string> device;
@@ -30,7 +31,11 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--config", args->config, "YAML file of training options (see --print-options).");
   cmd->add_option("--set", args->overrides, "Override one option, e.g. --set densify.max_gaussians=1000000 (repeatable).");
   cmd->add_option("--ablation", args->ablations,
-                  "Paper Table 1 ablation: no-warp, no-shading, no-network, no-densify, ga-binding, mlp-only (repeatable).");
+                  "Paper Table 1 ablation: no-warp, no-shading, no-network, no-densify, ga-binding, mlp-only, cap-200k "
+                  "(repeatable).");
+  cmd->add_option("--baseline", args->baseline,
+                  "Train another method instead of TeGA: gaussian-avatars (GaussianAvatars' rigging, densification and "
+                  "losses, no networks; docs/training.md#the-gaussianavatars-baseline).");
   cmd->add_flag("--resume", args->resume, "Continue the run in --out from its checkpoint (its saved options apply; "
                                           "--iterations and --device still override).");
   cmd->add_option("--stop-at", args->stop_at,
@@ -45,6 +50,7 @@ void add_train_command(CLI::App& app) {
     } else if (!args->config.empty()) {
       load_options(options, args->config);
     }
+    if (!args->baseline.empty()) trainer::apply_baseline(options, args->baseline);
     for (const auto& ablation : args->ablations) trainer::apply_ablation(options, ablation);
     for (const auto& kv : args->overrides) {
       const auto eq = kv.find('=');

@@ -8,6 +8,7 @@
 #include "tega/core/error.h"
 #include "tega/trainer/spherical_harmonics.h"
 #include "tega/uvd/fused_covariance.h"
+#include "tega/uvd/triangle_rig.h"
 
 namespace tega::trainer {
 
@@ -55,6 +56,9 @@ AvatarModel::AvatarModel(const Dataset& dataset, const TrainOptions& options, co
   eyeball_face_mask_ = eyeball_face_mask_.to(device);
   network = nn::ExpressionNetwork(options.network);
   network->to(device);
+  const at::Tensor active = lookup_.uv_area() > 0;
+  const at::Tensor scale = uvd::triangle_frames(template_vertices_, lookup_.faces()).scale;
+  mean_triangle_scale_ = scale.index({active}).mean().item<double>();
 }
 
 FrameInput AvatarModel::frame_input(const Vertices& world_vertices, const RigidTransform& head_to_world) const {
@@ -77,7 +81,8 @@ PosedGaussians AvatarModel::pose(const FrameInput& frame, const Phase& phase) {
   at::Tensor means, jacobian, triangle;
   {
     TEGA_TRACE_SCOPE("uvd_to_world");
-    uvd::UvdMapping mapping = uvd::uvd_to_world(g.uvd, frame.mesh, lookup_, g.bound_triangle);
+    uvd::UvdMapping mapping = g.rigged ? uvd::rigged_to_world(g.uvd, g.bound_triangle, frame.mesh, lookup_.faces())
+                                       : uvd::uvd_to_world(g.uvd, frame.mesh, lookup_, g.bound_triangle);
     means = std::move(mapping.xyz);
     jacobian = std::move(mapping.jacobian);
     triangle = std::move(mapping.triangle);
@@ -85,6 +90,7 @@ PosedGaussians AvatarModel::pose(const FrameInput& frame, const Phase& phase) {
 
   at::Tensor shading;
   if (phase.deformation || phase.shading) {
+    TORCH_CHECK(!g.rigged, "rigged Gaussians have no uvd for the networks");
     {
       TEGA_TRACE_SCOPE("encoder");
       out.latents = network->encode(frame.displacement_texture);

@@ -85,8 +85,8 @@ DensifyResult densify(Gaussians& g, Adam& adam, const DensifyStats& stats, const
   }
   const at::Tensor keep = split.logical_or(prune).logical_not().nonzero().flatten();
   rebuild(g, adam, keep, appended, appended_triangles);
-  // The new rows went to the end: back into uv_order (see gaussians.h).
-  rebuild(g, adam, uv_order(g.uvd), {}, {});
+  // The new rows went to the end: back into order (see gaussians.h).
+  rebuild(g, adam, gaussian_order(g), {}, {});
 
   DensifyResult r;
   r.cloned = clone_ids.size(0);

@@ -64,8 +64,32 @@ Gaussians initialise_gaussians(const uvd::UvTriangleLookup& lookup, int64_t coun
   return g;
 }
 
-Gaussians gaussians_from_tensors(const std::map<std::string, at::Tensor>& tensors, const at::Device& device) {
+Gaussians initialise_rigged_gaussians(const uvd::UvTriangleLookup& lookup, const at::TensorOptions& options) {
+  at::NoGradGuard no_grad;
   Gaussians g;
+  g.rigged = true;
+  g.bound_triangle = (lookup.uv_area() > 0).nonzero().flatten().to(options.device());
+  const int64_t count = g.bound_triangle.size(0);
+  g.uvd = at::zeros({count, 3}, options);
+  g.log_scale = at::full({count, 3}, std::log(0.5), options);
+  g.rotation = at::zeros({count, 4}, options);
+  g.rotation.select(1, 0).fill_(1.0);
+  g.sh_dc = at::zeros({count, 1, 3}, options);
+  g.sh_rest = at::zeros({count, 15, 3}, options);
+  g.opacity_logit = at::full({count}, std::log(0.1 / 0.9), options);
+  for (const auto& name : Gaussians::parameter_names()) g.parameter(name).requires_grad_(true);
+  return g;
+}
+
+at::Tensor gaussian_order(const Gaussians& g) {
+  if (!g.rigged) return uv_order(g.uvd);
+  return std::get<1>(g.bound_triangle.sort(/*stable=*/true, /*dim=*/0, /*descending=*/false));
+}
+
+Gaussians gaussians_from_tensors(const std::map<std::string, at::Tensor>& tensors, const at::Device& device,
+                                 bool rigged) {
+  Gaussians g;
+  g.rigged = rigged;
   for (const auto& name : Gaussians::parameter_names()) {
     auto it = tensors.find("gaussians." + name);
     if (it == tensors.end()) throw Error("checkpoint has no tensor 'gaussians." + name + "'");
@@ -73,6 +97,7 @@ Gaussians gaussians_from_tensors(const std::map<std::string, at::Tensor>& tensor
   }
   auto bound = tensors.find("gaussians.bound_triangle");
   if (bound != tensors.end()) g.bound_triangle = bound->second.to(device);
+  if (rigged && !g.bound_triangle.defined()) throw Error("checkpoint of a rigged run has no 'gaussians.bound_triangle'");
   return g;
 }
 

@@ -16,10 +16,19 @@ int64_t period(double fraction, int64_t iterations) { return std::max<int64_t>(1
 }  // namespace tega::trainer
 
 namespace tega::trainer {
+namespace {
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
+
+}  // namespace
 
 const std::vector<std::string>& ablation_names() {
   static const std::vector<std::string> names{"no-warp", "no-shading", "no-network", "no-densify", "ga-binding",
-                                              "mlp-only"};
+                                              "mlp-only", "cap-200k"};
   return names;
 }
 
@@ -36,10 +45,43 @@ void apply_ablation(TrainOptions& options, const std::string& ablation) {
     options.binding = "triangle";
   } else if (ablation == "mlp-only") {
     options.network.latent = "global";
+  } else if (ablation == "cap-200k") {
+    options.densify.max_gaussians = 200000;
   } else {
-    std::string known;
-    for (const auto& n : ablation_names()) known += (known.empty() ? "" : ", ") + n;
-    throw Error("unknown ablation '" + ablation + "'; known: " + known);
+    throw Error("unknown ablation '" + ablation + "'; known: " + joined(ablation_names()));
+  }
+}
+
+const std::vector<std::string>& baseline_names() {
+  static const std::vector<std::string> names{"gaussian-avatars"};
+  return names;
+}
+
+void apply_baseline(TrainOptions& options, const std::string& baseline) {
+  if (baseline != "gaussian-avatars") {
+    throw Error("unknown baseline '" + baseline + "'; known: " + joined(baseline_names()));
+  }
+  // GA's rigging, no networks, no perceptual term.
+  options.binding = "rigged";
+  options.deformation_field = options.dynamic_shading = false;
+  options.loss.vgg_weights.clear();
+  // GA's adaptive density control as fractions of its 600K iterations:
+  // from 10K to the end, every 2K, opacity reset every 60K; at most ~200K.
+  options.densify.enabled = true;
+  options.densify.start = 10000.0 / 600000.0;
+  options.densify.stop = 1.0;
+  options.densify.interval = 2000.0 / 600000.0;
+  options.densify.opacity_reset_interval = 60000.0 / 600000.0;
+  options.densify.max_gaussians = 200000;
+}
+
+void validate_train_options(const TrainOptions& options) {
+  if (options.binding != "uvd" && options.binding != "triangle" && options.binding != "rigged") {
+    throw Error("binding must be 'uvd', 'triangle' or 'rigged', not '" + options.binding + "'");
+  }
+  if (options.binding == "rigged" && (options.deformation_field || options.dynamic_shading)) {
+    throw Error("binding: rigged (GaussianAvatars) has no UVD space for the networks: set deformation_field and "
+                "dynamic_shading to false (--baseline gaussian-avatars does)");
   }
 }
 

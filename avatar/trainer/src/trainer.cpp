@@ -106,9 +106,7 @@ class Run {
         model_((validate_dataset(dataset_), dataset_), options, device_),
         generator_(at::make_generator<at::CPUGeneratorImpl>(static_cast<uint64_t>(options.seed))),
         profiler_(options.profile, device_) {
-    if (options_.binding != "uvd" && options_.binding != "triangle") {
-      throw Error("binding must be 'uvd' or 'triangle', not '" + options_.binding + "'");
-    }
+    validate_train_options(options_);
     train_views_ = views_of(dataset_, dataset_.train.frames, dataset_.train.cameras);
     heldout_views_ = views_of(dataset_, dataset_.train.frames, dataset_.test.cameras);
     if (!options_.loss.vgg_weights.empty()) {
@@ -121,9 +119,12 @@ class Run {
     if (control.resume) {
       restore_latest();
     } else {
-      model_.gaussians = initialise_gaussians(model_.lookup(), options_.initial_gaussians, model_.metres_per_uv(),
-                                              options_.binding == "triangle", static_cast<uint64_t>(options_.seed),
-                                              at::TensorOptions(at::kFloat).device(device_));
+      const at::TensorOptions floats = at::TensorOptions(at::kFloat).device(device_);
+      model_.gaussians = options_.binding == "rigged"
+                             ? initialise_rigged_gaussians(model_.lookup(), floats)
+                             : initialise_gaussians(model_.lookup(), options_.initial_gaussians, model_.metres_per_uv(),
+                                                    options_.binding == "triangle",
+                                                    static_cast<uint64_t>(options_.seed), floats);
       register_parameters();
       stats_ = splat::MeanGradientStats::zeros(model_.gaussians.uvd);
       max_world_std_ = at::zeros({model_.gaussians.size()}, background_.options());
@@ -277,6 +278,7 @@ class Run {
     const double vgg_weight = schedules::vgg_weight(options_.loss, iteration_, options_.iterations);
     if (vgg_ && vgg_weight > 0) loss = loss + vgg_weight * (*vgg_)(rendered.unsqueeze(0), target.unsqueeze(0));
     if (smoothness.defined()) loss = loss + smoothness;
+    if (model_.gaussians.rigged) loss = loss + rig_regularisers();
     if (poisoned_iterations_.erase(iteration_ + 1)) loss = loss * std::numeric_limits<double>::quiet_NaN();
     const at::Tensor mse = (rendered.detach() - target).pow(2).mean();
 
@@ -314,6 +316,17 @@ class Run {
     const at::Tensor jacobians = model_.network->deform(samples, posed.latents, true).jacobian;
     return schedules::smoothness_weight(options_.loss, iteration_, options_.iterations) *
            nn::jacobian_smoothness_loss(jacobians, nn::Reduction::mean);
+  }
+
+  // GaussianAvatars' position and scale regularisers, in local units: they
+  // keep a rigged Gaussian near its triangle and no larger than it, so that
+  // it does not swing when the triangle turns.
+  at::Tensor rig_regularisers() const {
+    const auto& l = options_.loss;
+    const Gaussians& g = model_.gaussians;
+    const at::Tensor position = at::relu(g.uvd.norm(2, 1) - l.rig_position_threshold).mean();
+    const at::Tensor scale = at::relu(g.log_scale.exp() - l.rig_scale_threshold).norm(2, 1).mean();
+    return l.rig_position * position + l.rig_scale * scale;
   }
 
   // A host tensor on the training device without waiting for the GPU (a
@@ -392,15 +405,22 @@ class Run {
       stats_ = splat::MeanGradientStats::zeros(model_.gaussians.uvd);
       max_world_std_ = at::zeros({model_.gaussians.size()}, background_.options());
     }
-    if (it % period(d.opacity_reset_interval, options_.iterations) == 0) reset_opacity(model_.gaussians, adam_);
+    // As 3DGS, only while densification goes on: a reset at its stop (the
+    // run's last step, where GaussianAvatars' densification ends) would
+    // leave the opacities no iterations to recover.
+    if (it < at_fraction(d.stop, options_.iterations) && it % period(d.opacity_reset_interval, options_.iterations) == 0) {
+      reset_opacity(model_.gaussians, adam_);
+    }
   }
 
   void register_parameters() {
     adam_ = Adam();
     const auto& lr = options_.learning_rates;
     auto& g = model_.gaussians;
-    const double uv = 1.0 / model_.metres_per_uv();
-    adam_.add("uvd", g.uvd, lr.position, at::tensor({uv, uv, 1.0}, g.uvd.options().requires_grad(false)).view({1, 3}));
+    // Position learning rates are in metres: uv, d and rigged local units convert.
+    const double uv = 1.0 / model_.metres_per_uv(), local = 1.0 / model_.mean_triangle_scale();
+    const std::vector<double> per_metre = g.rigged ? std::vector<double>{local, local, local} : std::vector<double>{uv, uv, 1.0};
+    adam_.add("uvd", g.uvd, lr.position, at::tensor(per_metre, g.uvd.options().requires_grad(false)).view({1, 3}));
     adam_.add("log_scale", g.log_scale, lr.scale);
     adam_.add("rotation", g.rotation, lr.rotation);
     adam_.add("sh_dc", g.sh_dc, lr.sh_dc);
@@ -453,7 +473,7 @@ class Run {
   }
 
   void restore(const Checkpoint& c, const fs::path& file) {
-    model_.gaussians = gaussians_from_tensors(c.tensors, device_);
+    model_.gaussians = gaussians_from_tensors(c.tensors, device_, options_.binding == "rigged");
     nn::load_module_tensors(*model_.network, c.tensors, file, "network.");
     register_parameters();
     adam_.load_state(c.tensors);

@@ -9,6 +9,8 @@
 // D is learned in head space and rotated by the frame's head pose, so that a
 // rigid head motion does not have to be learned by the field. Eyeball
 // Gaussians (by the triangle they map through) are not deformed.
+// Rigged Gaussians (the GaussianAvatars baseline) map through their
+// triangle's frame instead of F (uvd/triangle_rig.h), with J = k R.
 
 #include <ATen/ATen.h>
 
@@ -59,6 +61,9 @@ class AvatarModel {
 
   const uvd::UvTriangleLookup& lookup() const { return lookup_; }
   double metres_per_uv() const { return metres_per_uv_; }
+  // Mean scale k (metres) of the template's active triangles: metres per
+  // unit of a rigged Gaussian's local coordinates, on average.
+  double mean_triangle_scale() const { return mean_triangle_scale_; }
   const at::Device& device() const { return device_; }
 
  private:
@@ -68,6 +73,7 @@ class AvatarModel {
   at::Tensor template_vertices_;  // [V,3] head space
   at::Tensor eyeball_face_mask_;  // [F] bool
   double metres_per_uv_ = 1.0;
+  double mean_triangle_scale_ = 1.0;
 };
 
 // sqrt(world area / UV area) of a mesh's triangles: metres per unit of uv.

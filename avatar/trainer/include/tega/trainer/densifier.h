@@ -2,8 +2,9 @@
 // Adaptive density control of 3D Gaussian Splatting, performed in UVD space
 // (TeGA §3.8): thresholds use screen-space gradients and world sizes, while
 // clones copy uvd and splits sample children from N(μ_uvd, Σ_uvd). Every new
-// uv is projected back onto the valid UV domain (in triangle-binding mode
-// children inherit their parent's triangle instead), and the optimizer's
+// uv is projected back onto the valid UV domain (in the triangle and rigged
+// bindings children inherit their parent's triangle instead; rigged ones are
+// sampled in its local frame, as GaussianAvatars does), and the optimizer's
 // moments follow the rows.
 
 #include <ATen/ATen.h>

@@ -24,6 +24,10 @@ struct Gaussians {
   // GaussianAvatars-style binding (ablation): the triangle each Gaussian is
   // bound to, [N] int64; undefined in TeGA's free UVD mode.
   at::Tensor bound_triangle;
+  // GaussianAvatars' rigging (binding: rigged, uvd/triangle_rig.h): `uvd`
+  // then holds each Gaussian's local position μ in its bound triangle's
+  // frame, and log_scale its local scale, both in units of the triangle's k.
+  bool rigged = false;
 
   int64_t size() const { return uvd.size(0); }
 
@@ -39,6 +43,15 @@ struct Gaussians {
 Gaussians initialise_gaussians(const uvd::UvTriangleLookup& lookup, int64_t count, double metres_per_uv,
                                bool bind_to_triangles, uint64_t seed, const at::TensorOptions& options);
 
+// GaussianAvatars' initialisation: one Gaussian at the centroid of every
+// active triangle (nonzero UV area), isotropic with a local std of half the
+// triangle's scale k, grey, opacity 0.1, rigged.
+Gaussians initialise_rigged_gaussians(const uvd::UvTriangleLookup& lookup, const at::TensorOptions& options);
+
+// The memory order the densifier keeps: uv_order for UVD Gaussians, by bound
+// triangle (stable) for rigged ones, whose uvd holds no uv.
+at::Tensor gaussian_order(const Gaussians& g);
+
 // The permutation that sorts Gaussians (uv or uvd rows) by the row-major
 // cell of a 256² grid over uv (stable). Neighbours on the texture then sit together in memory,
 // so the per-Gaussian gathers (mesh corners, latent texels) and the atomic
@@ -47,6 +60,8 @@ Gaussians initialise_gaussians(const uvd::UvTriangleLookup& lookup, int64_t coun
 at::Tensor uv_order(const at::Tensor& uv);
 
 // Rebuilds from checkpoint tensors; throws tega::Error naming what is missing.
-Gaussians gaussians_from_tensors(const std::map<std::string, at::Tensor>& tensors, const at::Device& device);
+// `rigged`: the run's binding is rigged (its checkpoint then holds bound_triangle).
+Gaussians gaussians_from_tensors(const std::map<std::string, at::Tensor>& tensors, const at::Device& device,
+                                 bool rigged);
 
 }  // namespace tega::trainer

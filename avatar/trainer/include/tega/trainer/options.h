@@ -71,6 +71,12 @@ struct LossOptions {
   double smoothness_initial = 1.0;
   double smoothness_final = 0.1;      // reached at half of training
   int64_t smoothness_samples = 100000;
+  // GaussianAvatars' regularisers (binding: rigged only), in units of each
+  // Gaussian's triangle scale k.
+  double rig_position = 0.01;
+  double rig_position_threshold = 1.0;
+  double rig_scale = 1.0;
+  double rig_scale_threshold = 0.6;
   template <class V>
   void visit(V& v) {
     v("l1", l1, "Weight of the L1 term.");
@@ -80,6 +86,12 @@ struct LossOptions {
     v("smoothness_initial", smoothness_initial, "Jacobian smoothness weight at the first iteration.");
     v("smoothness_final", smoothness_final, "Smoothness weight from mid-training on (exponential decay before).");
     v("smoothness_samples", smoothness_samples, "Random uvd samples per step for the smoothness term.");
+    v("rig_position", rig_position,
+      "binding: rigged only (GaussianAvatars): weight of mean(max(|μ| - rig_position_threshold, 0)), μ the local position.");
+    v("rig_position_threshold", rig_position_threshold, "Local distance (in triangle scales) that is free of the position term.");
+    v("rig_scale", rig_scale,
+      "binding: rigged only (GaussianAvatars): weight of mean(|max(s - rig_scale_threshold, 0)|), s the local standard deviations.");
+    v("rig_scale_threshold", rig_scale_threshold, "Local standard deviation (in triangle scales) that is free of the scale term.");
   }
 };
 
@@ -96,7 +108,7 @@ struct TrainOptions {
   std::vector<double> background{0.0, 0.0, 0.0};
   bool deformation_field = true;                 // false: the 'no warp' ablation
   bool dynamic_shading = true;                   // false: the 'no shading' ablation
-  std::string binding = "uvd";                   // uvd (TeGA) or triangle (GaussianAvatars)
+  std::string binding = "uvd";                   // uvd (TeGA), triangle or rigged (GaussianAvatars)
   bool antialiased = false;
   int64_t checkpoint_every = 5000;
   double rollback_learning_rate_factor = 0.5;  // after a NaN/Inf step
@@ -125,7 +137,10 @@ struct TrainOptions {
     v("background", background, "Background colour (linear RGB) that images are composited on.");
     v("deformation_field", deformation_field, "Learn the UVD deformation field. false: the 'no warp' ablation.");
     v("dynamic_shading", dynamic_shading, "Learn the dynamic shading. false: the 'no shading' ablation (both false: 'no network').");
-    v("binding", binding, "uvd: Gaussians move freely across triangles (TeGA); triangle: each keeps its triangle (GaussianAvatars).");
+    v("binding", binding,
+      "uvd: Gaussians move freely across triangles (TeGA); triangle: each keeps the triangle it started on, still through "
+      "the UVD map ('No Triangle Updates'); rigged: GaussianAvatars' rigging, local coordinates in the triangle's "
+      "frame scaled by its size, one Gaussian per triangle at the start (initial_gaussians unused; the networks must be off).");
     v("antialiased", antialiased, "Mip-Splatting-style antialiased rasterization.");
     v("checkpoint_every", checkpoint_every, "Iterations between checkpoints (plus one at the start and one at the end).");
     v("rollback_learning_rate_factor", rollback_learning_rate_factor,
@@ -153,8 +168,18 @@ int64_t period(double fraction, int64_t iterations);
 namespace tega::trainer {
 
 // The paper's Table 1 ablations by name: no-warp, no-shading, no-network,
-// no-densify, ga-binding, mlp-only. Throws tega::Error for another name.
+// no-densify, ga-binding, mlp-only, cap-200k. Throws tega::Error for another name.
 void apply_ablation(TrainOptions& options, const std::string& ablation);
 const std::vector<std::string>& ablation_names();
+
+// Another method trained by the same trainer: "gaussian-avatars" (Qian et al.
+// 2024; docs/training.md#the-gaussianavatars-baseline). Applied on top of the
+// run's options. Throws tega::Error for another name.
+void apply_baseline(TrainOptions& options, const std::string& baseline);
+const std::vector<std::string>& baseline_names();
+
+// Throws tega::Error naming what is wrong with a combination of options that
+// the trainer cannot run (an unknown binding, networks with rigged Gaussians).
+void validate_train_options(const TrainOptions& options);
 
 }  // namespace tega::trainer
