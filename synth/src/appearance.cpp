@@ -60,6 +60,8 @@ Eigen::Vector3f mix(const Eigen::Vector3f& a, const Eigen::Vector3f& b, float t)
 
 }  // namespace
 
+float lip_weight(const Eigen::Vector3f& fp) { return gauss(fp.x() / 0.38f, (fp.y() + 1.06f) / 0.12f); }
+
 Appearance::Appearance(uint64_t seed) : seed_(seed) {
   const float tone = static_cast<float>(uniform(seed, kTone, 0));
   skin_tone_ = mix(Eigen::Vector3f(0.80f, 0.60f, 0.50f), Eigen::Vector3f(0.50f, 0.34f, 0.25f), tone);
@@ -71,7 +73,7 @@ Eigen::Vector3f Appearance::skin(const Eigen::Vector2f& uv, const Eigen::Vector3
   Eigen::Vector3f c = skin_tone_ * float(0.9 + 0.2 * value_noise(hash_of(seed_, kBlotch), uv.x() * 7, uv.y() * 7));
   c.x() += float(0.06 * (value_noise(hash_of(seed_, kRedness), uv.x() * 12, uv.y() * 12) - 0.5));
 
-  const float lips = gauss(fp.x() / 0.38f, (fp.y() + 1.06f) / 0.12f);
+  const float lips = lip_weight(fp);
   c = mix(c, Eigen::Vector3f(0.62f, 0.30f, 0.30f), 0.7f * lips);
 
   c *= 1.0f - 0.3f * dots(seed_, kPores, uv, 420, 0.18, 0.8);

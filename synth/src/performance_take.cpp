@@ -20,6 +20,7 @@ struct FrameGeometry {
   RigidTransform head_to_world;
   Vertices coarse;  // world
   FineFrame fine;   // world
+  FrameLighting lighting;          // the expression's shadows and gloss, for every camera
   RigidTransform dataset_pose;     // the dataset's head_to_world (lagged with tracking_error.lag_pose)
   nlohmann::json tracking_error;   // what the tracking-error model did (when it is on)
 };
@@ -78,6 +79,7 @@ void render_performance(const Studio& studio, const std::string& take, const Dat
       g.dataset_pose = g.head_to_world;
       g.coarse = model.evaluate({}, g.expression, g.head_to_world);
       g.fine = studio.maker.make(g.coarse, g.expression);
+      g.lighting = studio.shader.frame_lighting(g.coarse, g.expression, g.fine);
       const std::string id = take + "_" + frame_name(f);
       write_vertices_bin(g.coarse, gt / "coarse" / (frame_name(f) + ".bin"));
       if (o.write_fine_meshes) write_vertices_bin(g.fine.positions, gt / "fine" / (frame_name(f) + ".bin"));
@@ -122,7 +124,7 @@ void render_performance(const Studio& studio, const std::string& take, const Dat
     studio.pool.parallel_for(0, int64_t(count) * n_cameras, [&](int64_t task) {
       const int i = static_cast<int>(task / n_cameras), c = static_cast<int>(task % n_cameras);
       const int f = first + i;
-      const Surface head = studio.shader.surface(geometry[i].fine);
+      const Surface head = studio.shader.surface(geometry[i].fine, geometry[i].lighting);
       const uint64_t noise = hash_of(uint64_t(o.seed), hash_string(take.c_str()), c, f);
       // One render through the lens-free camera gives the dataset's
       // undistorted image (alpha = exact coverage); the lens bends it into

@@ -75,6 +75,16 @@ void validate_options(const Options& o) {
   if (o.noise_sigma < 0 || o.wrinkle_depth_m < 0 || o.crease_darkening < 0)
     throw Error("noise_sigma, wrinkle_depth_m and crease_darkening must not be negative");
   validate_tracking_error_options(o.tracking_error);
+  const SelfShadowOptions& shadows = o.self_shadowing;
+  if (shadows.map_size < 64 || shadows.map_size > 8192) throw Error("self_shadowing.map_size must be in 64 .. 8192");
+  if (!(shadows.softness_m >= 0 && shadows.softness_m <= 0.05))
+    throw Error("self_shadowing.softness_m must be in 0 .. 0.05 metres");
+  const ExpressionSpecularOptions& specular = o.expression_specular;
+  for (const auto& [name, value] : {std::pair{"stretch_exponent", specular.stretch_exponent},
+                                    std::pair{"crease_matte", specular.crease_matte},
+                                    std::pair{"wet_lips", specular.wet_lips}})
+    if (!(value >= 0 && value <= 10))
+      throw Error(std::string("expression_specular.") + name + " must be in 0 .. 10");
 }
 
 Head make_head(const Options& o) {
@@ -100,7 +110,7 @@ SynthSummary render_virtual_studio(const Options& o, const std::filesystem::path
   const Rig rig = make_studio_rig(o.studio);
   const Appearance appearance(uint64_t(o.seed));
   const Backdrop backdrop(uint64_t(o.seed));
-  const HeadShader shader(head, maker, appearance);
+  const HeadShader shader(head, maker, appearance, o.self_shadowing, o.expression_specular);
   const TrackingError tracking_error(head, o.tracking_error, uint64_t(o.seed));
   ThreadPool pool(o.threads);
   spdlog::info("synth: {} head ({} vertices, {} fine triangles), {} cameras at {}x{}", head.source,

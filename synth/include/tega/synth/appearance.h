@@ -9,6 +9,10 @@
 
 namespace tega::synth {
 
+// How much a point of the neutral face (face frame, interocular units) is
+// lip: 1 at the mouth's centre, falling off as a Gaussian.
+float lip_weight(const Eigen::Vector3f& face_point);
+
 class Appearance {
  public:
   explicit Appearance(uint64_t seed);

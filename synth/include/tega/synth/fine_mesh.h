@@ -47,6 +47,8 @@ class FineMeshMaker {
   FineFrame make(const Vertices& coarse, const std::vector<float>& expression) const;
 
   const Mesh& fine_topology() const { return subdivision_.fine; }
+  // How each fine vertex blends the coarse ones.
+  const Subdivision& subdivision() const { return subdivision_; }
   // Per fine triangle: 0 skin, 1 left eyeball, 2 right eyeball.
   const std::vector<int8_t>& fine_triangle_eye() const { return fine_triangle_eye_; }
   // The wrinkle regions whose drivers the model has, and how strongly those

@@ -103,6 +103,55 @@ struct TrackingErrorOptions {
   }
 };
 
+// Cast shadows of the fine mesh from the studio's directional lights onto
+// itself (creases, folds, an open mouth, the eye sockets): one shadow map per
+// light per frame, filtered to a soft edge. Off by default (every image is
+// then byte-identical to a studio without it).
+// docs/virtual-studio.md#expression-dependent-appearance
+struct SelfShadowOptions {
+  bool enabled = false;
+  int map_size = 1024;
+  double softness_m = 0.001;
+
+  template <class V>
+  void visit(V& v) {
+    v("enabled", enabled,
+      "Shadow the directional lights' diffuse and specular terms by the head's own fine mesh (the "
+      "ambient term and the light that wraps past the terminator stay unshadowed).");
+    v("map_size", map_size,
+      "Shadow map side, texels (64 .. 8192), spanning the head's bounding sphere: 1024 gives ~0.45 mm "
+      "texels on ICT-FaceKit's head.");
+    v("softness_m", softness_m,
+      "Radius, metres, of the shadows' soft edge (percentage-closer filtering); at least one texel is used.");
+  }
+};
+
+// Skin gloss (specular strength and Blinn-Phong exponent, scaled together)
+// that follows the expression: stretched skin shinier, compressed skin and
+// creases more matte, lips wetter as the jaw opens. Every factor is 1 by
+// default, which leaves every image byte-identical.
+// docs/virtual-studio.md#expression-dependent-appearance
+struct ExpressionSpecularOptions {
+  double stretch_exponent = 0.0;
+  double crease_matte = 0.0;
+  double wet_lips = 0.0;
+
+  bool enabled() const { return stretch_exponent != 0 || crease_matte != 0 || wet_lips != 0; }
+
+  template <class V>
+  void visit(V& v) {
+    v("stretch_exponent", stretch_exponent,
+      "Gloss factor (area ratio)^stretch_exponent, the area ratio being that of the coarse mesh around "
+      "a point against the neutral pose: > 1 stretched (shinier), < 1 compressed (more matte); 0 = none.");
+    v("crease_matte", crease_matte,
+      "Gloss factor (crease shading)^crease_matte in the wrinkles' creases, whose crease shading is "
+      "1 - crease_darkening at the bottom of a full crease; 0 = none.");
+    v("wet_lips", wet_lips,
+      "Gloss factor 1 + wet_lips * lips * jawOpen: the lips (weight 1 at their centre) grow wetter as "
+      "the jaw opens; 0 = none.");
+  }
+};
+
 struct Options {
   StudioOptions studio;
   int frames = 30;
@@ -125,6 +174,8 @@ struct Options {
   bool write_fine_meshes = true;
   bool truth_apart = false;
   TrackingErrorOptions tracking_error;
+  SelfShadowOptions self_shadowing;
+  ExpressionSpecularOptions expression_specular;
   int threads = 0;
 
   template <class V>
@@ -168,6 +219,9 @@ struct Options {
     v("tracking_error", tracking_error,
       "Tracking errors in the dataset's meshes only (dataset/meshes; never the images or ground_truth/); "
       "all off by default.");
+    v("self_shadowing", self_shadowing, "Cast shadows of the head on itself from the studio's lights; off by default.");
+    v("expression_specular", expression_specular,
+      "Skin gloss that changes with the expression (stretch, creases, wet lips); off by default.");
     v("threads", threads, "Worker threads; 0 = one per hardware thread.");
   }
 };
