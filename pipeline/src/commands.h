@@ -13,6 +13,7 @@ void add_capture_command(CLI::App& app);
 void add_calibrate_command(CLI::App& app);
 void add_mvs_command(CLI::App& app);
 void add_track_command(CLI::App& app);
+void add_landmarks_command(CLI::App& app);
 void add_matte_command(CLI::App& app);
 void add_train_command(CLI::App& app);
 void add_render_command(CLI::App& app);

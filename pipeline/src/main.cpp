@@ -36,6 +36,9 @@ int main(int argc, char** argv) {
 #ifdef TEGA_HAVE_TRACKING
   tega::cli::add_track_command(app);
 #endif
+#ifdef TEGA_HAVE_LANDMARKS
+  tega::cli::add_landmarks_command(app);
+#endif
 #ifdef TEGA_HAVE_MATTING
   tega::cli::add_matte_command(app);
 #endif

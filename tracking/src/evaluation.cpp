@@ -4,14 +4,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "tega/core/error.h"
 #include "tega/core/files.h"
-#include "tega/core/image.h"
 #include "tega/core/mesh.h"
-#include "tega/core/rig.h"
 #include "tega/mvs/studio_truth.h"
 #include "tega/tracking/tracked.h"
 
@@ -56,52 +53,6 @@ double pearson(const std::vector<double>& a, const std::vector<double>& b) {
 }
 
 }  // namespace
-
-std::vector<int> studio_model_vertices(const fs::path& capture) {
-  const int studio_vertices = read_obj(capture / "ground_truth" / "head" / "template.obj").num_vertices();
-  const fs::path file = capture / "ground_truth" / "head" / "head.json";
-  const auto head = read_json(file);
-  std::vector<int> model_vertex;
-  for (const auto& run : head.value("source_vertex_runs", nlohmann::json::array()))
-    for (int v = run.at(0).get<int>(); v <= run.at(1).get<int>(); ++v) model_vertex.push_back(v);
-  if (model_vertex.empty())
-    for (int v = 0; v < studio_vertices; ++v) model_vertex.push_back(v);
-  if (int(model_vertex.size()) != studio_vertices)
-    throw Error(file, "source_vertex_runs cover " + std::to_string(model_vertex.size()) + " vertices; template.obj has " +
-                          std::to_string(studio_vertices));
-  return model_vertex;
-}
-
-LandmarkSample studio_landmark_sample(const fs::path& capture, const std::string& take, const std::string& camera_name,
-                                      int frame, const std::vector<int>& landmark_vertices) {
-  const std::vector<int> model_vertex = studio_model_vertices(capture);
-  std::vector<int> studio_vertex(size_t(*std::max_element(model_vertex.begin(), model_vertex.end()) + 1), -1);
-  for (size_t v = 0; v < model_vertex.size(); ++v) studio_vertex[size_t(model_vertex[v])] = int(v);
-  Mesh mesh = read_obj(capture / "ground_truth" / "head" / "template.obj");
-  char name[32];
-  std::snprintf(name, sizeof name, "%06d", frame);
-  mesh.positions = read_vertices_bin(capture / "ground_truth" / take / "coarse" / (std::string(name) + ".bin"),
-                                     mesh.num_vertices());
-  const Vertices normals = mesh.vertex_normals();
-  const Rig rig = read_rig_json(capture / "rig.json");
-  const Camera& camera = rig.camera(camera_name);
-  LandmarkSample sample;
-  sample.image = read_image_u8(capture / "takes" / take / camera_name / (std::string(name) + ".png"));
-  for (const int model_index : landmark_vertices) {
-    const int vertex = size_t(model_index) < studio_vertex.size() ? studio_vertex[size_t(model_index)] : -1;
-    if (vertex < 0) throw Error(capture / "ground_truth" / "head" / "head.json", "the studio's head has no vertex " +
-                                                                                  std::to_string(model_index) + " of the model");
-    const Eigen::Vector3d position = mesh.positions.row(vertex).cast<double>();
-    const Eigen::Vector3d normal = normals.row(vertex).cast<double>();
-    const Eigen::Vector2d pixel = camera.project(position).value();
-    sample.box.extend(pixel);
-    const bool facing = normal.dot(camera.center() - position) > 0;
-    sample.landmarks.push_back(facing ? pixel : Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN()));
-  }
-  const Eigen::Vector2d margin = 0.075 * sample.box.sizes();
-  sample.box = FaceBox(sample.box.min() - margin, sample.box.max() + margin);
-  return sample;
-}
 
 TrackScores score_frames(const std::vector<ScoredFrame>& tracked, const fs::path& capture, const std::string& take) {
   const mvs::StudioTruth truth = mvs::load_studio_truth(capture, take, 0);

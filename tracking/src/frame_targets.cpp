@@ -13,7 +13,6 @@ namespace {
 constexpr int kFirstInnerLandmark = 17;
 constexpr double kOcclusionMarginM = 0.003;
 constexpr double kMinFacingCosine = 0.2;  // grazing views track poorly
-constexpr double kLandmarkBoxGrowth = 0.15;
 
 std::vector<Eigen::Vector3d> rows_of(const Vertices& world, const std::vector<int>& vertices) {
   std::vector<Eigen::Vector3d> points;
@@ -105,8 +104,7 @@ Term<ImageTarget> landmark_targets(const HeadModel& model, const PosedModel& pos
       if (!pixel) return;
       box.extend(*pixel);
     }
-    const Eigen::Vector2d grow = kLandmarkBoxGrowth * box.sizes();
-    box = FaceBox(box.min() - grow, box.max() + grow);
+    box = grown_landmark_box(box);
     if (!box.intersects(FaceBox(Eigen::Vector2d::Zero(), Eigen::Vector2d(image.width, image.height)))) return;
     const auto found = detector.detect(image, options.detector_boxes ? std::nullopt : std::optional<FaceBox>(box));
     if (!found) return;

@@ -6,23 +6,18 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <iostream>
-#include <limits>
-#include <nlohmann/json.hpp>
+#include <memory>
 #include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "small_studio.h"
-#include "tega/core/error.h"
-#include "tega/core/files.h"
 #include "tega/core/image.h"
-#include "tega/core/mesh.h"
-#include "tega/core/rig.h"
 #include "tega/synth/virtual_studio.h"
-#include "tega/tracking/evaluation.h"
+#include "tega/tracking/landmark_capture_training.h"
+#include "tega/tracking/landmark_studio_truth.h"
 #include "tega/tracking/landmarks.h"
 #include "test_support.h"
 
@@ -60,8 +55,8 @@ synth::Options studio_options(const fs::path& ict) {
 
 struct Capture {
   fs::path root;
-  Rig rig;
   std::vector<int> landmark_vertices;
+  std::unique_ptr<StudioLandmarkTruth> truth;
 };
 
 const Capture& studio_capture(const fs::path& ict) {
@@ -72,24 +67,17 @@ const Capture& studio_capture(const fs::path& ict) {
     std::cout << "rendered " << summary.images << " images in " << seconds_since(start) << " s\n";
     Capture c;
     c.root = dir / "capture";
-    c.rig = read_rig_json(c.root / "rig.json");
-    const auto indices = nlohmann::json::parse(read_text_file(ict / "vertex_indices.json"));
-    c.landmark_vertices = indices.at("idx_to_landmark_verts").get<std::vector<int>>();
+    c.landmark_vertices = model_landmark_vertices(ict);
+    c.truth = std::make_unique<StudioLandmarkTruth>(c.root, c.landmark_vertices);
     return c;
   }();
   return capture;
 }
 
-std::string frame_name(int frame) {
-  char name[16];
-  std::snprintf(name, sizeof name, "%06d", frame);
-  return name;
-}
-
-// The true landmarks of one image (tracking's studio_landmark_sample).
+// The true landmarks of one image.
 LandmarkSample true_sample(const Capture& capture, const std::string& take, const std::string& camera_name,
                            int frame) {
-  return studio_landmark_sample(capture.root, take, camera_name, frame, capture.landmark_vertices);
+  return capture.truth->sample(capture.truth->frame(take, frame), camera_name);
 }
 
 double median(std::vector<double> values) {
@@ -114,12 +102,14 @@ const fs::path& trained_predictor(const fs::path& ict) {
   static const test::TempDir dir;
   static const fs::path predictor = [&] {
     const Capture& capture = studio_capture(ict);
+    LandmarkSamplingOptions sampling;
+    sampling.frame_stride = 2;  // the even frames
+    sampling.max_view_angle_deg = 180;
+    for (const std::string& camera : capture.truth->rig().camera_names())
+      if (camera != kHeldOutCamera) sampling.cameras.push_back(camera);
     std::vector<LandmarkSample> samples;
-    for (const std::string& take : kTakes)
-      for (const std::string& camera : capture.rig.camera_names())
-        for (int frame = 0; frame < kFrames; ++frame)
-          if (camera != kHeldOutCamera && is_training_frame(frame))
-            samples.push_back(true_sample(capture, take, camera, frame));
+    for (CaptureLandmarkSample& sample : capture_landmark_samples(capture.root, capture.landmark_vertices, sampling))
+      samples.push_back(std::move(sample.sample));
     const auto start = std::chrono::steady_clock::now();
     train_landmark_predictor(samples, LandmarkTrainingOptions{}, dir / "predictor.dat");
     std::cout << "trained on " << samples.size() << " images in " << seconds_since(start) << " s\n";
@@ -134,7 +124,7 @@ TEST(Landmarks, TrainedPredictorFindsTheLandmarksOfUnseenFramesAndCameras) {
   const LandmarkDetector detector(trained_predictor(ict));
   std::vector<double> errors, held_out_camera_errors;
   for (const std::string& take : kTakes)
-    for (const std::string& camera : capture.rig.camera_names())
+    for (const std::string& camera : capture.truth->rig().camera_names())
       for (int frame = 0; frame < kFrames; ++frame) {
         if (is_training_frame(frame)) continue;
         const LandmarkSample truth = true_sample(capture, take, camera, frame);

@@ -1,6 +1,7 @@
 #include <dlib/image_processing.h>
 #include <dlib/serialize.h>
 
+#include <iostream>
 #include <string>
 #include <thread>
 
@@ -39,6 +40,21 @@ void check_training_input(const std::vector<LandmarkSample>& samples, const Land
     if (!landmark_seen[j]) fail("landmark " + std::to_string(j) + " is unknown in every sample");
 }
 
+// dlib prints its progress to std::cout, and stdout is for results: for as
+// long as it lives, what goes to std::cout goes to stderr.
+class ProgressToStderr {
+ public:
+  explicit ProgressToStderr(bool active) : previous_(active ? std::cout.rdbuf(std::cerr.rdbuf()) : nullptr) {}
+  ~ProgressToStderr() {
+    if (previous_) std::cout.rdbuf(previous_);
+  }
+  ProgressToStderr(const ProgressToStderr&) = delete;
+  ProgressToStderr& operator=(const ProgressToStderr&) = delete;
+
+ private:
+  std::streambuf* previous_;
+};
+
 int worker_threads(int requested) {
   return requested > 0 ? requested : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
 }
@@ -66,6 +82,8 @@ void train_landmark_predictor(const std::vector<LandmarkSample>& samples, const 
   trainer.set_oversampling_amount(options.oversampling);
   trainer.set_nu(options.nu);
   trainer.set_num_threads(worker_threads(options.threads));
+  if (options.print_progress) trainer.be_verbose();
+  const ProgressToStderr progress_to_stderr(options.print_progress);
   dlib::shape_predictor predictor;
   try {
     predictor = trainer.train(images, shapes);

@@ -12,7 +12,7 @@
 
 #include "tega/core/geometry.h"
 #include "tega/core/mesh.h"
-#include "tega/tracking/landmarks.h"
+#include "tega/tracking/landmark_studio_truth.h"  // studio_model_vertices, studio_landmark_sample
 
 namespace tega::tracking {
 
@@ -22,17 +22,6 @@ struct TrackScores {
   double rotation_median_deg = 0, rotation_max_deg = 0;
   std::map<std::string, double> correlation;  // per true expression that varies: Pearson r over the frames
 };
-
-// The model's vertex index of each vertex of the studio's template
-// (head.json's source_vertex_runs; the same numbering where it has none).
-std::vector<int> studio_model_vertices(const std::filesystem::path& capture);
-
-// A training sample for a landmark predictor from a studio photo: the true
-// mesh's landmark vertices (`landmark_vertices`, the model's numbering)
-// projected through the rig's lens; those on the far side of the head
-// (normal facing away) are NaN. The box: all 68 grown by 15 %.
-LandmarkSample studio_landmark_sample(const std::filesystem::path& capture, const std::string& take,
-                                      const std::string& camera, int frame, const std::vector<int>& landmark_vertices);
 
 // The studio's ground truth in tega track's layout (docs/layouts.md#tracked-meshes):
 // its template as the subject (identity.json, identity_neutral.obj) and the

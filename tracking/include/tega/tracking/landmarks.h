@@ -20,6 +20,14 @@ constexpr int kLandmarkCount = 68;
 // A face's bounding box in pixels: min = top-left, max = bottom-right.
 using FaceBox = Eigen::AlignedBox2d;
 
+// The box tega's predictors are trained on and given: the landmarks' own
+// bounding box grown by 7.5 % of its size on each side (15 % in all). A
+// predictor learns its box's framing, so training and detection must agree.
+inline FaceBox grown_landmark_box(const FaceBox& landmarks) {
+  const Eigen::Vector2d margin = 0.075 * landmarks.sizes();
+  return FaceBox(landmarks.min() - margin, landmarks.max() + margin);
+}
+
 class LandmarkDetector {
  public:
   // Throws tega::Error naming the file when it is missing or not a dlib
@@ -61,6 +69,20 @@ struct LandmarkTrainingOptions {
   // 68-point markup's symmetry): twice the views for the same renders.
   bool add_mirrored_samples = true;
   int threads = 0;  // 0: one per hardware thread
+  // dlib prints the trees fitted so far and the time left to stdout.
+  bool print_progress = false;
+
+  template <class V>
+  void visit(V& v) {
+    v("cascade_depth", cascade_depth, "Cascade levels, each refining the shape the one before left.");
+    v("tree_depth", tree_depth, "Depth of every regression tree (2^depth leaves).");
+    v("trees_per_cascade_level", trees_per_cascade_level, "Regression trees fitted at each cascade level.");
+    v("oversampling", oversampling, "Random initial shapes per training sample.");
+    v("nu", nu, "Shrinkage (learning rate) of each tree, in (0, 1].");
+    v("add_mirrored_samples", add_mirrored_samples,
+      "Also train on every sample mirrored left to right (landmarks renumbered by the markup's symmetry).");
+    v("threads", threads, "Worker threads (0: one per hardware thread).");
+  }
 };
 
 // Trains a dlib shape predictor (dlib's shape_predictor_trainer) on the
