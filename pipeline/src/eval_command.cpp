@@ -12,7 +12,7 @@ namespace tega::cli {
 namespace {
 struct EvalArguments {
   std::vector<std::string> models, names;
-  std::string data, split = "test", json, lpips_vgg, lpips_lin, device;
+  std::string data, split = "test", json, lpips_vgg, lpips_lin, landmark_predictor, device;
 };
 }  // namespace
 
@@ -30,6 +30,10 @@ void add_eval_command(CLI::App& app) {
   cmd->add_option("--json", args->json, "Output JSON file; the Markdown table goes beside it (.md).")->required();
   cmd->add_option("--lpips-vgg", args->lpips_vgg, "VGG-16 weights (safetensors, torchvision names) for LPIPS.");
   cmd->add_option("--lpips-lin", args->lpips_lin, "LPIPS linear-layer weights (safetensors, lpips package names).");
+  cmd->add_option("--landmark-predictor", args->landmark_predictor,
+                  "dlib 68-point shape predictor (.dat) for landmark_px: the landmarks it finds on the render and on "
+                  "the ground truth in the same face box, compared (needs a build with dlib and the dataset's 68 "
+                  "landmark_vertices; docs/render-eval-export.md#landmarks).");
   cmd->add_option("--device", args->device, "cpu or cuda (default: each run's device).");
   cmd->callback([args] {
     if (!args->names.empty() && args->names.size() != args->models.size())
@@ -38,6 +42,9 @@ void add_eval_command(CLI::App& app) {
       throw Error("tega eval: LPIPS needs both --lpips-vgg and --lpips-lin");
     std::optional<tools::Lpips> lpips;
     if (!args->lpips_vgg.empty()) lpips = tools::Lpips::load(args->lpips_vgg, args->lpips_lin);
+    tools::LandmarkPredictor landmark_predictor;  // empty: landmark_px skipped
+    if (!args->landmark_predictor.empty())
+      landmark_predictor = tools::load_landmark_predictor(args->landmark_predictor);
     const std::filesystem::path data =
         args->data.empty() ? tools::run_dataset(args->models.front()) : std::filesystem::path(args->data);
 
@@ -46,7 +53,7 @@ void add_eval_command(CLI::App& app) {
     for (size_t i = 0; i < args->models.size(); ++i) {
       const std::filesystem::path run_dir = args->models[i];
       tools::LoadedRun run = tools::load_run(run_dir, data, args->device);
-      if (!notes) notes = tools::evaluation_notes(run.dataset, lpips.has_value());
+      if (!notes) notes = tools::evaluation_notes(run.dataset, lpips.has_value(), args->landmark_predictor);
       tools::ModelResult result;
       result.name = args->names.empty() ? std::filesystem::absolute(run_dir).lexically_normal().filename().string()
                                         : args->names[i];
@@ -54,7 +61,8 @@ void add_eval_command(CLI::App& app) {
       result.run = run_dir;
       result.iteration = run.avatar->iteration;
       result.gaussians = run.avatar->model.gaussians.size();
-      result.splits = tools::evaluate_avatar(*run.avatar, run.dataset, args->split, lpips ? &*lpips : nullptr);
+      result.splits = tools::evaluate_avatar(*run.avatar, run.dataset, args->split, lpips ? &*lpips : nullptr,
+                                             landmark_predictor ? &landmark_predictor : nullptr);
       results.push_back(std::move(result));
     }
     tools::write_evaluation(results, *notes, args->json);

@@ -4,12 +4,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <optional>
 
 #include "image_tensors.h"
 #include "tega/core/error.h"
 #include "tega/core/files.h"
 #include "tega/core/progress.h"
+#include "tega/tools/closeups.h"
 #include "tega/tools/landmarks.h"
 #include "tega/tools/metrics.h"
 #include "tega/trainer/render.h"
@@ -19,10 +21,13 @@ namespace tega::tools {
 namespace fs = std::filesystem;
 
 const std::vector<std::string>& metric_names() {
-  static const std::vector<std::string> names{"landmark_px",    "lpips",      "ssim",
-                                              "psnr",           "l1",         "ssim_masked",
-                                              "psnr_masked",    "l1_masked",  "hf_psnr_masked",
-                                              "gradient_error_masked"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out{"landmark_px",    "landmark_drift_px", "lpips",       "ssim",
+                                 "psnr",           "l1",                "ssim_masked", "psnr_masked",
+                                 "l1_masked",      "hf_psnr_masked",    "gradient_error_masked"};
+    out.insert(out.end(), closeup_metric_names().begin(), closeup_metric_names().end());
+    return out;
+  }();
   return names;
 }
 
@@ -42,7 +47,14 @@ std::vector<SplitViews> evaluation_views(const Dataset& dataset, const std::stri
 }
 
 std::vector<SplitResult> evaluate_avatar(trainer::TrainedAvatar& avatar, const Dataset& dataset,
-                                         const std::string& split, const Lpips* lpips) {
+                                         const std::string& split, const Lpips* lpips,
+                                         const LandmarkPredictor* landmark_predictor) {
+  // Close-ups and the detector's face box need the 68 points of the markup, in its order.
+  const bool markup = dataset.landmark_vertices.size() == kMarkupLandmarks;
+  if (landmark_predictor && !markup)
+    throw Error(dataset.root / "dataset.json",
+                "the landmark predictor's face box needs the 68 landmark_vertices of the Multi-PIE markup; the "
+                "dataset defines " + std::to_string(dataset.landmark_vertices.size()));
   const std::vector<SplitViews> splits = evaluation_views(dataset, split);
   const at::Device device = avatar.model.device();
   const at::Tensor background = at::tensor(avatar.options.background, at::kFloat).to(device);
@@ -85,16 +97,27 @@ std::vector<SplitResult> evaluate_avatar(trainer::TrainedAvatar& avatar, const D
               .clamp(0.0, 1.0);
 
       ViewResult v{view.camera, view.frame, {}};
+      const ErrorMaps maps = error_maps(rendered, target);
+      const MaskedMetrics head = masked_metrics(maps, mask);
       v.metrics["psnr"] = psnr(rendered, target);
-      v.metrics["ssim"] = ssim(rendered, target);
+      v.metrics["ssim"] = maps.ssim.mean().item<double>();
       v.metrics["l1"] = l1(rendered, target);
-      v.metrics["psnr_masked"] = psnr(rendered, target, mask);
-      v.metrics["ssim_masked"] = ssim(rendered, target, mask);
+      v.metrics["psnr_masked"] = head.psnr;
+      v.metrics["ssim_masked"] = head.ssim;
       v.metrics["l1_masked"] = l1(rendered, target, mask);
-      v.metrics["hf_psnr_masked"] = hf_psnr(rendered, target, mask);
-      v.metrics["gradient_error_masked"] = gradient_error(rendered, target, mask);
+      v.metrics["hf_psnr_masked"] = head.hf_psnr;
+      v.metrics["gradient_error_masked"] = head.gradient_error;
       if (lpips_here) v.metrics["lpips"] = (*lpips_here)(rendered, target);
-      if (landmarks) v.metrics["landmark_px"] = landmark_error_px(reference_landmarks, avatar_landmarks, camera);
+      if (landmarks) v.metrics["landmark_drift_px"] = landmark_drift_px(reference_landmarks, avatar_landmarks, camera);
+      if (markup) {
+        const std::vector<std::optional<Eigen::Vector2d>> projected = project_landmarks(reference_landmarks, camera);
+        v.metrics.merge(closeup_metrics(maps, mask, projected));
+        if (landmark_predictor) {
+          const std::optional<Eigen::AlignedBox2d> box = landmark_detection_box(projected);
+          v.metrics["landmark_px"] = box ? detected_landmark_error_px(*landmark_predictor, rendered, target, *box)
+                                         : std::numeric_limits<double>::quiet_NaN();
+        }
+      }
       result.views.push_back(std::move(v));
       progress.advance();
     }
@@ -104,18 +127,38 @@ std::vector<SplitResult> evaluate_avatar(trainer::TrainedAvatar& avatar, const D
   return results;
 }
 
-EvalNotes evaluation_notes(const Dataset& dataset, bool lpips) {
+EvalNotes evaluation_notes(const Dataset& dataset, bool lpips, const fs::path& landmark_predictor) {
   EvalNotes notes;
   if (!lpips)
     notes.lpips = "LPIPS skipped: no VGG/LPIPS weight files were given (--lpips-vgg, --lpips-lin; "
                   "docs/render-eval-export.md#lpips-weights)";
-  notes.landmarks =
+  if (landmark_predictor.empty())
+    notes.landmark_px = "landmark_px skipped: no landmark predictor was given (--landmark-predictor, a dlib 68-point "
+                        "shape predictor; docs/render-eval-export.md#landmarks)";
+  else
+    notes.landmark_px = "landmark_px: mean distance in pixels over the 68 landmarks that the predictor " +
+                        landmark_predictor.string() +
+                        " finds on the render and on the ground truth, both in the same box (the tracked mesh's "
+                        "landmark vertices projected, their bounding box grown by 15 %); NaN where a landmark "
+                        "vertex is behind the camera";
+  notes.landmark_drift_px =
       dataset.landmark_vertices.empty()
-          ? "landmark error skipped: the dataset defines no landmark_vertices"
-          : "landmark_px: mean pixel distance between the tracked mesh's landmark vertices and the avatar's deformed "
-            "landmark points (F + R_head D at the vertex's uv, d = 0), both projected; it measures how far the "
-            "deformation field moves the landmarks off the tracked surface, not a detector-based alignment as in the "
-            "paper";
+          ? "landmark_drift_px skipped: the dataset defines no landmark_vertices"
+          : "landmark_drift_px: mean pixel distance between the tracked mesh's landmark vertices and the avatar's "
+            "deformed landmark points (F + R_head D at the vertex's uv, d = 0), both projected; it measures how far "
+            "the deformation field moves the landmarks off the tracked surface, a diagnostic of the field, not the "
+            "paper's detector-based landmark error (landmark_px)";
+  char closeup_note[512];
+  std::snprintf(closeup_note, sizeof closeup_note,
+                "closeup_eyes_* and closeup_mouth_*: psnr, ssim, hf_psnr and gradient_error inside the head mask "
+                "within boxes around the eyes (two boxes) and the mouth at the dataset's resolution; a box is the "
+                "bounding box of the part's projected landmark vertices, every side moved out by %.0f %% of its "
+                "longer side, at least %d px a side, clipped to the image",
+                100 * kCloseupMargin, kCloseupMinimumSide);
+  notes.closeups = dataset.landmark_vertices.size() == kMarkupLandmarks
+                       ? std::string(closeup_note)
+                       : "close-ups skipped: the dataset's landmark_vertices are not the 68 of the Multi-PIE markup "
+                         "(it defines " + std::to_string(dataset.landmark_vertices.size()) + ")";
   return notes;
 }
 
@@ -168,11 +211,18 @@ struct MetricColumn {
 
 MetricColumn metric_column(const std::string& metric) {
   static const std::map<std::string, MetricColumn> columns{
-      {"landmark_px", {"Landmark px ↓", 1}},  {"lpips", {"LPIPS ↓", 3}},
+      {"landmark_px", {"Landmark px ↓", 1}},  {"landmark_drift_px", {"Landmark drift px ↓", 1}},
+      {"lpips", {"LPIPS ↓", 3}},
       {"ssim", {"SSIM ↑", 3}},                {"psnr", {"PSNR ↑", 2}},
       {"l1", {"L1 ↓", 4}},                    {"ssim_masked", {"SSIM ↑", 3}},
       {"psnr_masked", {"PSNR ↑", 2}},         {"l1_masked", {"L1 ↓", 4}},
       {"hf_psnr_masked", {"HF PSNR ↑", 2}},   {"gradient_error_masked", {"Gradient error ↓", 4}}};
+  if (const auto it = columns.find(metric); it != columns.end()) return it->second;
+  // closeup_<region>_<metric>: the region's table titles its columns as the masked metric's.
+  for (const CloseupRegion& region : closeup_regions()) {
+    const std::string prefix = "closeup_" + region.name + "_";
+    if (metric.starts_with(prefix)) return columns.at(metric.substr(prefix.size()) + "_masked");
+  }
   return columns.at(metric);
 }
 
@@ -225,8 +275,10 @@ std::string table(const std::vector<ModelResult>& models, const std::vector<std:
 
 nlohmann::json evaluation_json(const std::vector<ModelResult>& models, const EvalNotes& notes) {
   nlohmann::json doc = {{"format", "tega-eval"}, {"version", 1}};
-  doc["notes"] = {{"lpips", notes.lpips.empty() ? "evaluated (lpips vgg v0.1)" : notes.lpips},
-                  {"landmarks", notes.landmarks},
+  doc["notes"] = {{"lpips", notes.lpips.empty() ? "lpips: evaluated (lpips vgg v0.1)" : notes.lpips},
+                  {"landmark_px", notes.landmark_px},
+                  {"landmark_drift_px", notes.landmark_drift_px},
+                  {"closeups", notes.closeups},
                   {"masked", "*_masked metrics are computed inside the head mask: the dataset image's alpha > 0.5"},
                   {"detail", kDetailNote},
                   {"statistics", "mean and population standard deviation over views; NaN values (an empty mask) are "
@@ -258,12 +310,19 @@ std::string evaluation_markdown(const std::vector<ModelResult>& models, const Ev
   std::string out = "# Evaluation (TeGA §5 protocol)\n\n";
   out += "Test reenactment: held-out frames from the training cameras. Novel view: training frames from the "
          "held-out cameras. Mean ± std over views.\n\n## Full image\n\n";
-  out += table(models, {"landmark_px", "lpips", "ssim", "psnr", "l1"});
+  out += table(models, {"landmark_px", "landmark_drift_px", "lpips", "ssim", "psnr", "l1"});
   out += "\n## Inside the head mask (alpha > 0.5)\n\n";
   out += table(models, {"ssim_masked", "psnr_masked", "l1_masked", "hf_psnr_masked", "gradient_error_masked"});
+  for (const CloseupRegion& region : closeup_regions()) {
+    const std::string prefix = "closeup_" + region.name + "_";
+    out += "\n## Close-up: " + region.name + ", inside the head mask (" + prefix + "*)\n\n";
+    out += table(models, {prefix + "ssim", prefix + "psnr", prefix + "hf_psnr", prefix + "gradient_error"});
+  }
   out += "\n";
   if (!notes.lpips.empty()) out += "- " + notes.lpips + "\n";
-  out += "- " + notes.landmarks + "\n";
+  out += "- " + notes.landmark_px + "\n";
+  out += "- " + notes.landmark_drift_px + "\n";
+  out += "- " + notes.closeups + "\n";
   out += std::string("- ") + kDetailNote + "\n";
   return out;
 }

@@ -1,5 +1,7 @@
 #include "image_tensors.h"
 
+#include <algorithm>
+
 #include "tega/core/error.h"
 
 namespace tega::tools::detail {
@@ -18,6 +20,14 @@ ImageF to_image(const at::Tensor& rgb) {
   const at::Tensor pixels = rgb.detach().permute({1, 2, 0}).to(at::kCPU, at::kFloat).contiguous();
   ImageF image(static_cast<int>(pixels.size(1)), static_cast<int>(pixels.size(0)), 3);
   std::copy_n(pixels.data_ptr<float>(), image.pixels.size(), image.pixels.begin());
+  return image;
+}
+
+Image8 to_image8(const at::Tensor& rgb) {
+  const at::Tensor pixels =
+      rgb.detach().clamp(0, 1).mul(255).round().permute({1, 2, 0}).to(at::kCPU, at::kByte).contiguous();
+  Image8 image(static_cast<int>(pixels.size(1)), static_cast<int>(pixels.size(0)), 3);
+  std::copy_n(pixels.data_ptr<uint8_t>(), image.pixels.size(), image.pixels.begin());
   return image;
 }
 

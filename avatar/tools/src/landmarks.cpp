@@ -55,20 +55,26 @@ at::Tensor LandmarkProbe::avatar(trainer::AvatarModel& model, const trainer::Fra
   return points.to(at::kCPU, at::kDouble);
 }
 
-double landmark_error_px(const at::Tensor& reference, const at::Tensor& avatar, const Camera& camera) {
-  const at::Tensor a = reference.to(at::kDouble).contiguous(), b = avatar.to(at::kDouble).contiguous();
+double landmark_drift_px(const at::Tensor& reference, const at::Tensor& avatar, const Camera& camera) {
+  const std::vector<std::optional<Eigen::Vector2d>> a = project_landmarks(reference, camera),
+                                                    b = project_landmarks(avatar, camera);
   double sum = 0;
   int64_t count = 0;
-  for (int64_t l = 0; l < a.size(0); ++l) {
-    const auto point = [](const at::Tensor& t, int64_t i) {
-      return Eigen::Vector3d(t[i][0].item<double>(), t[i][1].item<double>(), t[i][2].item<double>());
-    };
-    const auto pa = camera.project(point(a, l)), pb = camera.project(point(b, l));
-    if (!pa || !pb) continue;
-    sum += (*pa - *pb).norm();
+  for (size_t l = 0; l < a.size(); ++l) {
+    if (!a[l] || !b[l]) continue;
+    sum += (*a[l] - *b[l]).norm();
     ++count;
   }
   return count > 0 ? sum / count : std::numeric_limits<double>::quiet_NaN();
+}
+
+std::vector<std::optional<Eigen::Vector2d>> project_landmarks(const at::Tensor& points, const Camera& camera) {
+  const at::Tensor p = points.to(at::kCPU, at::kDouble).contiguous();
+  const double* xyz = p.data_ptr<double>();
+  std::vector<std::optional<Eigen::Vector2d>> pixels;
+  for (int64_t l = 0; l < p.size(0); ++l)
+    pixels.push_back(camera.project(Eigen::Map<const Eigen::Vector3d>(xyz + 3 * l)));
+  return pixels;
 }
 
 }  // namespace tega::tools

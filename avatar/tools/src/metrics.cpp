@@ -52,6 +52,24 @@ double masked_mean(const at::Tensor& per_pixel /* [H,W] */, const at::Tensor& ma
   return (per_pixel.to(at::kDouble) * mask.to(at::kDouble)).sum().item<double>() / pixels;
 }
 
+at::Tensor squared_error_map(const at::Tensor& a, const at::Tensor& b) {
+  return (a.to(at::kDouble) - b.to(at::kDouble)).square().mean(0);
+}
+
+at::Tensor gradient_error_map(const at::Tensor& a, const at::Tensor& b) {
+  return (gradient_magnitude(a) - gradient_magnitude(b)).abs().mean(0);
+}
+
+// The band is linear: filtering the difference once is the band of each.
+at::Tensor hf_squared_error_map(const at::Tensor& a, const at::Tensor& b) {
+  return high_pass(a.to(at::kDouble) - b.to(at::kDouble)).square().mean(0);
+}
+
+double masked_psnr(const at::Tensor& squared_error, const at::Tensor& mask) {
+  const double mse = masked_mean(squared_error, mask);
+  return std::isnan(mse) ? mse : mse_to_psnr(mse);
+}
+
 }  // namespace
 
 double psnr(const at::Tensor& a, const at::Tensor& b) {
@@ -61,8 +79,7 @@ double psnr(const at::Tensor& a, const at::Tensor& b) {
 
 double psnr(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask) {
   check_pair(a, b);
-  const double mse = masked_mean((a.to(at::kDouble) - b.to(at::kDouble)).square().mean(0), mask);
-  return std::isnan(mse) ? mse : mse_to_psnr(mse);
+  return masked_psnr(squared_error_map(a, b), mask);
 }
 
 at::Tensor ssim_map(const at::Tensor& a_in, const at::Tensor& b_in) {
@@ -100,14 +117,22 @@ double l1(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask) {
 
 double gradient_error(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask) {
   check_pair(a, b);
-  return masked_mean((gradient_magnitude(a) - gradient_magnitude(b)).abs().mean(0), mask);
+  return masked_mean(gradient_error_map(a, b), mask);
 }
 
 double hf_psnr(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask) {
   check_pair(a, b);
-  // The band is linear: filtering the difference once is the band of each.
-  const double mse = masked_mean(high_pass(a.to(at::kDouble) - b.to(at::kDouble)).square().mean(0), mask);
-  return std::isnan(mse) ? mse : mse_to_psnr(mse);
+  return masked_psnr(hf_squared_error_map(a, b), mask);
+}
+
+ErrorMaps error_maps(const at::Tensor& a, const at::Tensor& b) {
+  check_pair(a, b);
+  return {squared_error_map(a, b), ssim_map(a, b), gradient_error_map(a, b), hf_squared_error_map(a, b)};
+}
+
+MaskedMetrics masked_metrics(const ErrorMaps& maps, const at::Tensor& mask) {
+  return {masked_psnr(maps.squared_error, mask), masked_mean(maps.ssim, mask),
+          masked_psnr(maps.hf_squared_error, mask), masked_mean(maps.gradient_error, mask)};
 }
 
 Statistics statistics(const std::vector<double>& values) {

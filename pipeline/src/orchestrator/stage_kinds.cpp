@@ -95,8 +95,8 @@ std::vector<StageKind> make_stage_kinds() {
   eval.needs = {"run", "dataset"};
   eval.provides = {{"eval", "eval.json"}, {"eval_table", "eval.md"}};
   eval.options_as = OptionsAs::flags;
-  eval.flag_options = {"split", "lpips_vgg", "lpips_lin", "device"};
-  eval.path_options = {"lpips_vgg", "lpips_lin"};
+  eval.flag_options = {"split", "lpips_vgg", "lpips_lin", "landmark_predictor", "device"};
+  eval.path_options = {"lpips_vgg", "lpips_lin", "landmark_predictor"};
   eval.device_option = "device";
   eval.arguments = [](const ShardPaths& p) {
     return with_flags({"--model", p.artifacts.at("run").string(), "--data", p.artifacts.at("dataset").string(),

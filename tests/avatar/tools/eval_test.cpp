@@ -61,10 +61,12 @@ TEST(Eval, ScoresTheViewsOfThePapersProtocol) {
     EXPECT_NEAR(v.metrics.at("psnr_masked"), v.metrics.at("psnr"), 1e-9);
     EXPECT_EQ(v.metrics.count("lpips"), 0u);
     EXPECT_EQ(v.metrics.count("landmark_px"), 0u);
+    EXPECT_EQ(v.metrics.count("landmark_drift_px"), 0u);
+    EXPECT_EQ(v.metrics.count("closeup_mouth_psnr"), 0u);
   }
 }
 
-TEST(Eval, LandmarksFollowTheDeformationField) {
+TEST(Eval, LandmarkDriftFollowsTheDeformationField) {
   test::TinyAvatar tiny;
   tiny.dataset.landmark_vertices = {0, 1, 2};
   const LandmarkProbe probe(tiny.dataset, at::kCPU);
@@ -74,10 +76,10 @@ TEST(Eval, LandmarksFollowTheDeformationField) {
   // Without the field the avatar's landmarks are the tracked vertices.
   const at::Tensor rigid = probe.avatar(tiny.model(), input, {false, true, 3});
   EXPECT_TRUE(at::allclose(rigid, probe.reference(vertices), 1e-6, 1e-6));
-  EXPECT_NEAR(landmark_error_px(probe.reference(vertices), rigid, camera), 0.0, 1e-4);
+  EXPECT_NEAR(landmark_drift_px(probe.reference(vertices), rigid, camera), 0.0, 1e-4);
   // With it, they move by the field's displacement, projected.
   const at::Tensor moved = probe.avatar(tiny.model(), input, {true, true, 3});
-  const double error = landmark_error_px(probe.reference(vertices), moved, camera);
+  const double error = landmark_drift_px(probe.reference(vertices), moved, camera);
   EXPECT_GT(error, 1e-3);
   double expected = 0;
   for (int l = 0; l < 3; ++l) {
@@ -89,7 +91,81 @@ TEST(Eval, LandmarksFollowTheDeformationField) {
   EXPECT_NEAR(error, expected, 1e-9);
 
   const std::vector<SplitResult> splits = evaluate_avatar(*tiny.avatar, tiny.dataset, "test", nullptr);
-  EXPECT_NEAR(splits[0].views[0].metrics.at("landmark_px"), landmark_error_px(probe.reference(vertices), moved, camera), 1e-6);
+  EXPECT_NEAR(splits[0].views[0].metrics.at("landmark_drift_px"), landmark_drift_px(probe.reference(vertices), moved, camera), 1e-6);
+  // Three landmarks are not the 68-point markup: no close-ups, no face box for a detector.
+  EXPECT_EQ(splits[0].views[0].metrics.count("closeup_eyes_psnr"), 0u);
+  const LandmarkPredictor never_called = [](const Image8&, const Eigen::AlignedBox2d&) {
+    ADD_FAILURE() << "a predictor without a face box";
+    return std::vector<Eigen::Vector2d>(68);
+  };
+  EXPECT_THROW(evaluate_avatar(*tiny.avatar, tiny.dataset, "test", nullptr, &never_called), Error);
+}
+
+// The tiny triangle's three vertices stand for the 68 landmarks (landmark i
+// is vertex i mod 3): every part's box covers the 8x6 image.
+TEST(Eval, CloseupsAndDetectedLandmarksOfEveryView) {
+  test::TinyAvatar tiny;
+  tiny.dataset.landmark_vertices.clear();
+  for (int i = 0; i < 68; ++i) tiny.dataset.landmark_vertices.push_back(i % 3);
+  // A stand-in predictor: the 68 points at the box's centre, moved right by
+  // ten times the image's mean red (so render and truth differ), and every
+  // box it is given.
+  std::vector<Eigen::AlignedBox2d> boxes;
+  const LandmarkPredictor predictor = [&boxes](const Image8& image, const Eigen::AlignedBox2d& box) {
+    boxes.push_back(box);
+    double red = 0;
+    for (int y = 0; y < image.height; ++y)
+      for (int x = 0; x < image.width; ++x) red += image.at(x, y, 0) / 255.0 / (image.width * image.height);
+    return std::vector<Eigen::Vector2d>(68, box.center() + Eigen::Vector2d(10 * red, 0));
+  };
+  const std::vector<SplitResult> splits = evaluate_avatar(*tiny.avatar, tiny.dataset, "test", nullptr, &predictor);
+  ASSERT_EQ(boxes.size(), 4u);  // render and truth of two views
+
+  const at::Tensor background = at::tensor(tiny.avatar->options.background, at::kFloat);
+  const auto mean_red = [](const at::Tensor& rgb) {
+    return rgb[0].clamp(0, 1).mul(255).round().to(at::kDouble).mean().item<double>() / 255;
+  };
+  for (size_t s = 0; s < splits.size(); ++s) {
+    const ViewResult& v = splits[s].views[0];
+    const Camera& camera = tiny.dataset.rig.camera(v.camera);
+    // The box: the projected vertices' bounding box, grown by 7.5 % of its size on each side.
+    Eigen::AlignedBox2d expected;
+    const Vertices vertices = tiny.dataset.load_mesh(v.frame);
+    for (int i = 0; i < 3; ++i) expected.extend(*camera.project(vertices.row(i).cast<double>().transpose()));
+    const Eigen::Vector2d grow = 0.075 * expected.sizes();
+    for (const Eigen::AlignedBox2d& box : {boxes[2 * s], boxes[2 * s + 1]}) {
+      EXPECT_TRUE(box.min().isApprox(expected.min() - grow, 1e-9)) << box.min().transpose();
+      EXPECT_TRUE(box.max().isApprox(expected.max() + grow, 1e-9)) << box.max().transpose();
+    }
+    at::NoGradGuard no_grad;
+    const trainer::FrameInput input = tiny.model().frame_input(vertices, tiny.dataset.frame(v.frame).head_to_world);
+    const at::Tensor rendered =
+        trainer::render_view(tiny.model(), input, camera, tiny.avatar->phase, background, false).clamp(0, 1);
+    const at::Tensor target = trainer::composite_target(dataset_image(tiny.dataset, v.camera, v.frame), background);
+    EXPECT_NEAR(v.metrics.at("landmark_px"), 10 * std::abs(mean_red(rendered) - mean_red(target)), 1e-9);
+    EXPECT_GT(v.metrics.at("landmark_px"), 0.01);
+    // Every box covers the whole image, whose matte is opaque: the close-ups are the masked metrics.
+    for (const char* region : {"eyes", "mouth"}) {
+      const std::string prefix = std::string("closeup_") + region + "_";
+      EXPECT_NEAR(v.metrics.at(prefix + "psnr"), v.metrics.at("psnr_masked"), 1e-9);
+      EXPECT_NEAR(v.metrics.at(prefix + "ssim"), v.metrics.at("ssim_masked"), 1e-9);
+      EXPECT_NEAR(v.metrics.at(prefix + "hf_psnr"), v.metrics.at("hf_psnr_masked"), 1e-9);
+      EXPECT_NEAR(v.metrics.at(prefix + "gradient_error"), v.metrics.at("gradient_error_masked"), 1e-9);
+    }
+  }
+
+  ModelResult model{"Ours", tiny.tmp / "run", 6, 300, splits};
+  write_evaluation({model}, evaluation_notes(tiny.dataset, false, "predictor.dat"), tiny.tmp / "eval.json");
+  const auto doc = nlohmann::json::parse(read_text_file(tiny.tmp / "eval.json"));
+  const auto& reenactment = doc["models"][0]["splits"]["reenactment"]["metrics"];
+  EXPECT_NEAR(reenactment["landmark_px"]["mean"].get<double>(), splits[0].views[0].metrics.at("landmark_px"), 1e-9);
+  EXPECT_EQ(reenactment["closeup_mouth_hf_psnr"]["count"].get<int>(), 1);
+  EXPECT_NE(doc["notes"]["landmark_px"].get<std::string>().find("predictor.dat"), std::string::npos);
+  EXPECT_NE(doc["notes"]["closeups"].get<std::string>().find("40 % of its longer side"), std::string::npos);
+  const std::string markdown = read_text_file(tiny.tmp / "eval.md");
+  EXPECT_NE(markdown.find("## Close-up: mouth"), std::string::npos) << markdown;
+  EXPECT_NE(markdown.find("Novel view HF PSNR ↑"), std::string::npos) << markdown;
+  EXPECT_NE(markdown.find("Test reenactment Landmark px ↓"), std::string::npos) << markdown;
 }
 
 TEST(Eval, JsonAndMarkdownHoldStatisticsNotesAndInfinity) {
@@ -103,12 +179,13 @@ TEST(Eval, JsonAndMarkdownHoldStatisticsNotesAndInfinity) {
     v.metrics["ssim"] = 1.0;
     v.metrics["l1"] = 0.0;
   }
-  const EvalNotes notes = evaluation_notes(tiny.dataset, false);
+  const EvalNotes notes = evaluation_notes(tiny.dataset, false, "");
   write_evaluation({model, perfect}, notes, tiny.tmp / "eval/out.json");
 
   const auto doc = nlohmann::json::parse(read_text_file(tiny.tmp / "eval/out.json"));
   EXPECT_NE(doc["notes"]["lpips"].get<std::string>().find("skipped"), std::string::npos);
-  EXPECT_NE(doc["notes"]["landmarks"].get<std::string>().find("skipped"), std::string::npos);
+  for (const char* note : {"landmark_px", "landmark_drift_px", "closeups"})
+    EXPECT_NE(doc["notes"][note].get<std::string>().find("skipped"), std::string::npos) << note;
   ASSERT_EQ(doc["models"].size(), 2u);
   const auto& ours = doc["models"][0]["splits"];
   const double psnr_value = model.splits[0].views[0].metrics.at("psnr");
@@ -142,6 +219,7 @@ TEST(Eval, JsonAndMarkdownHoldStatisticsNotesAndInfinity) {
   std::snprintf(psnr_text, sizeof psnr_text, "%.2f ± 0.00", psnr_value);
   EXPECT_NE(markdown.find(psnr_text), std::string::npos) << markdown;
   EXPECT_NE(markdown.find("LPIPS skipped"), std::string::npos) << markdown;
+  EXPECT_NE(markdown.find("landmark_px skipped: no landmark predictor"), std::string::npos) << markdown;
 }
 
 TEST(Eval, TrainSplitAndUnknownSplits) {

@@ -9,10 +9,13 @@
 // Every view is rendered at the dataset's resolution and compared with its
 // image composited over the run's background: PSNR, SSIM and L1 on the full
 // image and inside the head mask (alpha > 0.5), the detail metrics of
-// metrics.h inside the mask, LPIPS when weights are given, and the landmark
-// error (landmarks.h) when the dataset defines
-// landmark vertices. Results: mean ± std per split, per camera and per frame,
-// and every view, as JSON, plus a Markdown table like the paper's Table 1.
+// metrics.h inside the mask, LPIPS when weights are given; where the dataset
+// defines landmark vertices, the deformation field's landmark drift
+// (landmarks.h), and with the 68-point markup the eye and mouth close-ups
+// (closeups.h) and, given a landmark predictor, the detected landmark error
+// (detected_landmarks.h). Results: mean ± std per split, per camera and per
+// frame, and every view, as JSON, plus Markdown tables like the paper's
+// Table 1.
 
 #include <filesystem>
 #include <map>
@@ -21,12 +24,13 @@
 #include <vector>
 
 #include "tega/core/dataset.h"
+#include "tega/tools/detected_landmarks.h"
 #include "tega/tools/lpips.h"
 #include "tega/trainer/trained_avatar.h"
 
 namespace tega::tools {
 
-// Metric names, in table order; the *_masked ones are inside the head mask.
+// Metric names, in table order; the *_masked and closeup_* ones are inside the head mask.
 const std::vector<std::string>& metric_names();
 
 struct ViewResult {
@@ -46,9 +50,12 @@ struct ModelResult {
   std::vector<SplitResult> splits;
 };
 
+// What each optional metric measures, or why it was skipped.
 struct EvalNotes {
-  std::string lpips;      // "" when evaluated, else why skipped
-  std::string landmarks;  // what the landmark error measures, or why skipped
+  std::string lpips;              // "" when evaluated
+  std::string landmark_px;        // the detected landmark error
+  std::string landmark_drift_px;  // the deformation field's landmark drift
+  std::string closeups;
 };
 
 struct EvalView {
@@ -63,11 +70,15 @@ struct SplitViews {
 // Throws tega::Error for another name or an empty split.
 std::vector<SplitViews> evaluation_views(const Dataset& dataset, const std::string& split);
 
-// Renders and scores every view of `split`. lpips may be null (skipped).
+// Renders and scores every view of `split`. lpips and landmark_predictor may
+// be null (skipped). Throws tega::Error when a predictor is given and the
+// dataset's landmark_vertices are not the 68 of the markup (no face box).
 std::vector<SplitResult> evaluate_avatar(trainer::TrainedAvatar& avatar, const Dataset& dataset,
-                                         const std::string& split, const Lpips* lpips);
+                                         const std::string& split, const Lpips* lpips,
+                                         const LandmarkPredictor* landmark_predictor = nullptr);
 
-EvalNotes evaluation_notes(const Dataset& dataset, bool lpips);
+// landmark_predictor: the predictor's file, empty when none was given.
+EvalNotes evaluation_notes(const Dataset& dataset, bool lpips, const std::filesystem::path& landmark_predictor);
 
 // The JSON document: notes, and per model and split the statistics of every
 // metric overall, per camera and per frame, and every view. Non-finite

@@ -1,19 +1,23 @@
 #pragma once
-// Landmark error of `tega eval` (docs/render-eval-export.md#landmarks).
+// The dataset's landmark vertices in `tega eval`
+// (docs/render-eval-export.md#landmark-drift): where the tracked mesh puts them,
+// projected into a view (the boxes of the close-ups and of the landmark
+// detector), and where the avatar moves them (landmark_drift_px).
 //
-// The paper runs a landmark detector on the ground truth and on the render
-// (§5). tega has no detector, so it measures something it can compute
-// exactly: for each landmark vertex the dataset defines (landmark_vertices),
-// the reference is the tracked mesh's vertex projected into the camera, and
-// the avatar's landmark is the same surface point moved by the avatar,
-// F(uv, d = 0) + R_head D(uv, 0; f_uv) (eyeball triangles excepted, as in
-// pose()), projected too. The error is the mean pixel distance over the
-// landmarks in front of the camera: how far the learned deformation drags
-// the landmarks off the tracked surface in the image. It is 0 for an avatar
-// without deformation field and is not comparable with the paper's numbers.
+// landmark_drift_px is a diagnostic of the deformation field, not the
+// paper's detector-based landmark error (that is landmark_px,
+// detected_landmarks.h): for each landmark vertex the reference is the
+// tracked mesh's vertex projected into the camera, and the avatar's landmark
+// is the same surface point moved by the avatar, F(uv, d = 0) +
+// R_head D(uv, 0; f_uv) (eyeball triangles excepted, as in pose()),
+// projected too. The drift is the mean pixel distance over the landmarks in
+// front of the camera: how far the learned deformation drags the landmarks
+// off the tracked surface in the image. It is 0 for an avatar without
+// deformation field.
 
 #include <ATen/ATen.h>
 
+#include <optional>
 #include <vector>
 
 #include "tega/core/camera.h"
@@ -42,6 +46,9 @@ class LandmarkProbe {
 
 // Mean pixel distance between the projections of two point sets [L,3]
 // (pairs with a point behind the camera are left out; NaN when none is left).
-double landmark_error_px(const at::Tensor& reference, const at::Tensor& avatar, const Camera& camera);
+double landmark_drift_px(const at::Tensor& reference, const at::Tensor& avatar, const Camera& camera);
+
+// The pixels of points [L,3] (world) in `camera`; nullopt behind it.
+std::vector<std::optional<Eigen::Vector2d>> project_landmarks(const at::Tensor& points, const Camera& camera);
 
 }  // namespace tega::tools

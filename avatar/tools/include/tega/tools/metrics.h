@@ -45,6 +45,24 @@ double l1(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask);
 double gradient_error(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask);
 double hf_psnr(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask);
 
+// The per-pixel maps [H,W] (double, on the images' device) whose means over a
+// mask are the masked metrics above. Eval filters each view once and averages
+// the maps over the head mask and over every close-up (closeups.h), so that a
+// close-up's filters see the pixels around it, as the masked metrics' do.
+struct ErrorMaps {
+  at::Tensor squared_error;     // (a - b)², mean over channels: PSNR
+  at::Tensor ssim;              // ssim_map
+  at::Tensor gradient_error;    // |Sobel magnitude of a - of b|, mean over channels
+  at::Tensor hf_squared_error;  // the difference's high-frequency band squared, mean over channels
+};
+ErrorMaps error_maps(const at::Tensor& a, const at::Tensor& b);
+
+// psnr, ssim, hf_psnr and gradient_error inside `mask` [H,W] bool (NaN for an empty mask).
+struct MaskedMetrics {
+  double psnr, ssim, hf_psnr, gradient_error;
+};
+MaskedMetrics masked_metrics(const ErrorMaps& maps, const at::Tensor& mask);
+
 // Mean and (population) standard deviation of the finite-or-infinite values
 // given; NaN values (e.g. masked metrics of an empty mask) are left out and
 // counted apart. With an infinite value the mean is infinite and the std NaN.
