@@ -1,4 +1,6 @@
 #include <algorithm>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <numeric>
 
 #include "tega/core/error.h"
@@ -72,6 +74,38 @@ Eigen::Vector3d centroid(const Mesh& mesh, const std::vector<int>& vertices) {
   return sum / std::max<size_t>(1, vertices.size());
 }
 
+// idx_to_landmark_verts of the model's vertex_indices.json, renumbered by
+// the vertices the studio kept; empty where the file or the list is absent.
+std::vector<int32_t> landmark_vertices(const std::filesystem::path& directory, const Head& head) {
+  const std::filesystem::path file = directory / "vertex_indices.json";
+  std::ifstream in(file);
+  if (!in) return {};
+  nlohmann::json indices;
+  try {
+    indices = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(file, std::string("is not valid JSON: ") + e.what());
+  }
+  if (!indices.contains("idx_to_landmark_verts")) return {};
+  std::vector<int> kept;  // the model's index of each studio vertex
+  for (const auto& [first, last] : head.source_vertex_runs)
+    for (int v = first; v <= last; ++v) kept.push_back(v);
+  std::vector<int32_t> out;
+  for (const int model_vertex : indices.at("idx_to_landmark_verts").get<std::vector<int>>()) {
+    int studio_vertex = model_vertex;
+    if (!kept.empty()) {
+      const auto found = std::lower_bound(kept.begin(), kept.end(), model_vertex);
+      if (found == kept.end() || *found != model_vertex)
+        throw Error(file, "landmark vertex " + std::to_string(model_vertex) + " is not on the studio's head");
+      studio_vertex = int(found - kept.begin());
+    }
+    if (studio_vertex < 0 || studio_vertex >= head.model.num_vertices())
+      throw Error(file, "landmark vertex " + std::to_string(model_vertex) + " is out of range");
+    out.push_back(studio_vertex);
+  }
+  return out;
+}
+
 }  // namespace
 
 Head load_head(const std::filesystem::path& directory, double metres_per_unit,
@@ -103,6 +137,7 @@ Head load_head(const std::filesystem::path& directory, double metres_per_unit,
   if (head.eyeball_faces.empty())
     throw Error(directory, "no triangle lies in the eyeball polygons [" + std::to_string(first) + ", " +
                                std::to_string(last) + "]");
+  head.landmark_vertices = landmark_vertices(directory, head);
   finish_head(head);
   return head;
 }

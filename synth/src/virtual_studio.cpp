@@ -158,6 +158,7 @@ SynthSummary render_virtual_studio(const Options& o, const std::filesystem::path
   for (Camera& cam : dataset.rig.cameras) cam.distortion = {};  // its images are undistorted
   dataset.template_mesh = head.model.neutral;
   dataset.eyeball_faces = head.eyeball_faces;
+  dataset.landmark_vertices = head.landmark_vertices;
   nlohmann::json tracking_error_frames = nlohmann::json::array();
   for (const auto& take : o.takes) {
     std::vector<DatasetFrame> frames;

@@ -55,6 +55,11 @@ struct Head {
   // Where the studio left parts of the model out: the model file's vertex
   // index of each vertex, as [first, last] runs (empty: the same numbering).
   std::vector<std::pair<int, int>> source_vertex_runs;
+  // The 68 Multi-PIE landmark vertices in the studio's numbering, where the
+  // model lists them (vertex_indices.json's idx_to_landmark_verts, as
+  // ICT-FaceKit does); empty otherwise. The dataset carries them for
+  // tega eval's landmark error and close-ups.
+  std::vector<int32_t> landmark_vertices;
   FaceFrame frame;
   Eigen::Vector3d pivot = Eigen::Vector3d::Zero();  // head-space point placed at the world origin
   std::vector<WrinkleRegion> wrinkles;
