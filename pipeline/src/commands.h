@@ -18,6 +18,7 @@ void add_matte_command(CLI::App& app);
 void add_train_command(CLI::App& app);
 void add_render_command(CLI::App& app);
 void add_eval_command(CLI::App& app);
+void add_inspect_command(CLI::App& app);
 void add_export_command(CLI::App& app);
 void add_run_command(CLI::App& app);
 void add_status_command(CLI::App& app);

@@ -48,6 +48,7 @@ int main(int argc, char** argv) {
 #ifdef TEGA_HAVE_TOOLS
   tega::cli::add_render_command(app);
   tega::cli::add_eval_command(app);
+  tega::cli::add_inspect_command(app);
   tega::cli::add_export_command(app);
 #endif
   tega::cli::add_run_command(app);

@@ -31,7 +31,7 @@ TEST(Cli, EveryCommandDescribesEveryFlag) {
   for (const char* command : {"dataset check", "dataset build", "synth", "rig convert", "ingest multiface", "train",
                               "eval", "render", "export", "run", "status", "capture", "capture list", "capture check",
                               "capture session", "capture validate", "calibrate", "calibrate board", "mvs",
-                              "mvs photos", "mvs mesh-workspace", "track", "landmarks train"}) {
+                              "mvs photos", "mvs mesh-workspace", "track", "landmarks train", "inspect"}) {
     const auto r = run_tega(std::string(command) + " --help");
     if (r.output.find("could not be matched") != std::string::npos) continue;  // command not built here
     EXPECT_EQ(r.exit_code, 0) << command << "\n" << r.output;

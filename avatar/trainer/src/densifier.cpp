@@ -16,10 +16,16 @@ void DensifyStats::reset(int64_t n, const at::Device& device) {
 
 namespace {
 
+// Rows [keep] of a per-Gaussian tensor followed by `appended` (undefined: none).
+at::Tensor kept_and_appended(const at::Tensor& rows, const at::Tensor& keep, const at::Tensor& appended) {
+  const at::Tensor kept = rows.index_select(0, keep);
+  return appended.defined() && appended.size(0) > 0 ? at::cat({kept, appended}) : kept;
+}
+
 // Rows [keep] of every parameter followed by `appended` rows (none when
-// empty); the moments follow.
+// empty); the moments and the per-Gaussian triangles follow.
 void rebuild(Gaussians& g, Adam& adam, const at::Tensor& keep, const std::map<std::string, at::Tensor>& appended,
-             const at::Tensor& appended_triangles) {
+             const at::Tensor& appended_bound, const at::Tensor& appended_birth) {
   const int64_t added = appended.empty() ? 0 : appended.begin()->second.size(0);
   for (const auto& name : Gaussians::parameter_names()) {
     at::Tensor& p = g.parameter(name);
@@ -28,10 +34,8 @@ void rebuild(Gaussians& g, Adam& adam, const at::Tensor& keep, const std::map<st
     adam.replace_rows(name, next, keep, added);
     p = next;
   }
-  if (g.bound_triangle.defined()) {
-    const at::Tensor kept = g.bound_triangle.index_select(0, keep);
-    g.bound_triangle = added > 0 ? at::cat({kept, appended_triangles}) : kept;
-  }
+  if (g.bound_triangle.defined()) g.bound_triangle = kept_and_appended(g.bound_triangle, keep, appended_bound);
+  if (g.birth_triangle.defined()) g.birth_triangle = kept_and_appended(g.birth_triangle, keep, appended_birth);
 }
 
 }  // namespace
@@ -79,14 +83,17 @@ DensifyResult densify(Gaussians& g, Adam& adam, const DensifyStats& stats, const
     if (name == "log_scale") children = children - std::log(1.6);
     appended[name] = at::cat({p.index_select(0, clone_ids), children}).detach();
   }
-  at::Tensor appended_triangles;
+  at::Tensor appended_bound, appended_birth;
   if (g.bound_triangle.defined()) {
-    appended_triangles = at::cat({g.bound_triangle.index_select(0, clone_ids), g.bound_triangle.index_select(0, parents)});
+    appended_bound = at::cat({g.bound_triangle.index_select(0, clone_ids), g.bound_triangle.index_select(0, parents)});
+  }
+  if (g.birth_triangle.defined() && appended.at("uvd").size(0) > 0) {
+    appended_birth = lookup.lookup(appended.at("uvd").slice(1, 0, 2)).triangle;
   }
   const at::Tensor keep = split.logical_or(prune).logical_not().nonzero().flatten();
-  rebuild(g, adam, keep, appended, appended_triangles);
+  rebuild(g, adam, keep, appended, appended_bound, appended_birth);
   // The new rows went to the end: back into order (see gaussians.h).
-  rebuild(g, adam, gaussian_order(g), {}, {});
+  rebuild(g, adam, gaussian_order(g), {}, {}, {});
 
   DensifyResult r;
   r.cloned = clone_ids.size(0);

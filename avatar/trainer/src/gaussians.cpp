@@ -31,6 +31,7 @@ std::map<std::string, at::Tensor> Gaussians::tensors() const {
                                       {"gaussians.sh_rest", sh_rest},
                                       {"gaussians.opacity_logit", opacity_logit}};
   if (bound_triangle.defined()) t["gaussians.bound_triangle"] = bound_triangle;
+  if (birth_triangle.defined()) t["gaussians.birth_triangle"] = birth_triangle;
   return t;
 }
 
@@ -59,7 +60,7 @@ Gaussians initialise_gaussians(const uvd::UvTriangleLookup& lookup, int64_t coun
   g.sh_dc = at::zeros({count, 1, 3}, options);  // colour 0.5
   g.sh_rest = at::zeros({count, 15, 3}, options);
   g.opacity_logit = at::full({count}, std::log(0.1 / 0.9), options);
-  if (bind_to_triangles) g.bound_triangle = lookup.lookup(uv).triangle;
+  (bind_to_triangles ? g.bound_triangle : g.birth_triangle) = lookup.lookup(uv).triangle;
   for (const auto& name : Gaussians::parameter_names()) g.parameter(name).requires_grad_(true);
   return g;
 }
@@ -97,6 +98,8 @@ Gaussians gaussians_from_tensors(const std::map<std::string, at::Tensor>& tensor
   }
   auto bound = tensors.find("gaussians.bound_triangle");
   if (bound != tensors.end()) g.bound_triangle = bound->second.to(device);
+  auto birth = tensors.find("gaussians.birth_triangle");
+  if (birth != tensors.end()) g.birth_triangle = birth->second.to(device);
   if (rigged && !g.bound_triangle.defined()) throw Error("checkpoint of a rigged run has no 'gaussians.bound_triangle'");
   return g;
 }

@@ -65,6 +65,21 @@ TEST_F(DensifierTest, SplitChildrenLandOnValidTrianglesAndShrink) {
   EXPECT_TRUE(gaussians.uvd.requires_grad());
 }
 
+// Every Gaussian records the triangle it was created on; children that land
+// on another triangle than their parent's record their own, so a count of
+// Gaussians off their birth triangle sees only later motion.
+TEST_F(DensifierTest, BirthTrianglesAreWhereEachGaussianWasCreated) {
+  ASSERT_TRUE(gaussians.birth_triangle.defined());
+  EXPECT_TRUE(at::equal(gaussians.birth_triangle, lookup.lookup(gaussians.uvd.detach().slice(1, 0, 2)).triangle));
+  {
+    at::NoGradGuard no_grad;
+    gaussians.log_scale.fill_(std::log(0.3));  // children spread over the charts
+  }
+  densify(gaussians, adam, stats_for(200, 1.0, 0.01), DensifyOptions(), lookup, generator);
+  ASSERT_EQ(gaussians.birth_triangle.size(0), gaussians.size());
+  EXPECT_TRUE(at::equal(gaussians.birth_triangle, lookup.lookup(gaussians.uvd.detach().slice(1, 0, 2)).triangle));
+}
+
 TEST_F(DensifierTest, SmallGaussiansAreClonedAndTransparentOnesPruned) {
   {
     at::NoGradGuard no_grad;

@@ -24,6 +24,11 @@ struct Gaussians {
   // GaussianAvatars-style binding (ablation): the triangle each Gaussian is
   // bound to, [N] int64; undefined in TeGA's free UVD mode.
   at::Tensor bound_triangle;
+  // TeGA's free UVD mode only: the triangle each Gaussian was created on
+  // (initialisation or densification), [N] int64, so that how many have
+  // since moved onto another triangle can be counted (tega inspect);
+  // undefined in the bound modes and in checkpoints from before it existed.
+  at::Tensor birth_triangle;
   // GaussianAvatars' rigging (binding: rigged, uvd/triangle_rig.h): `uvd`
   // then holds each Gaussian's local position μ in its bound triangle's
   // frame, and log_scale its local scale, both in units of the triangle's k.
@@ -34,7 +39,7 @@ struct Gaussians {
   // The parameters by name, as the optimizer and checkpoints see them.
   static const std::vector<std::string>& parameter_names();
   at::Tensor& parameter(const std::string& name);
-  std::map<std::string, at::Tensor> tensors() const;  // parameters + bound_triangle if any
+  std::map<std::string, at::Tensor> tensors() const;  // parameters + bound_triangle, birth_triangle if any
 };
 
 // `count` Gaussians spread uniformly over the valid UV area at d = 0, grey,

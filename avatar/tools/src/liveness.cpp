@@ -1,0 +1,238 @@
+#include "tega/tools/liveness.h"
+
+#include <ATen/ATen.h>
+#include <ATen/core/grad_mode.h>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include "image_tensors.h"
+#include "tega/nn/losses.h"
+#include "tega/trainer/render.h"
+
+namespace tega::tools {
+namespace {
+
+double pearson(const std::vector<double>& x, const std::vector<double>& y) {
+  const size_t n = x.size();
+  if (n < 2) return std::nan("");
+  double mx = 0, my = 0;
+  for (size_t i = 0; i < n; ++i) mx += x[i] / double(n), my += y[i] / double(n);
+  double sxy = 0, sxx = 0, syy = 0;
+  for (size_t i = 0; i < n; ++i) {
+    sxy += (x[i] - mx) * (y[i] - my);
+    sxx += (x[i] - mx) * (x[i] - mx);
+    syy += (y[i] - my) * (y[i] - my);
+  }
+  return sxx > 0 && syy > 0 ? sxy / std::sqrt(sxx * syy) : std::nan("");
+}
+
+double quantile_of(const at::Tensor& values, double q) {
+  return values.numel() == 0 ? 0.0 : at::quantile(values.to(at::kFloat), q).item<double>();
+}
+
+// Mean distance (mm) of a tracked mesh from the neutral template, in head space.
+double expression_mm(const Vertices& world, const RigidTransform& head_to_world, const Mesh& neutral) {
+  double sum = 0;
+  for (int v = 0; v < world.rows(); ++v) {
+    const Eigen::Vector3d head = head_to_world.R.transpose() * (world.row(v).cast<double>().transpose() - head_to_world.t);
+    sum += (head - neutral.positions.row(v).cast<double>().transpose()).norm();
+  }
+  return 1000.0 * sum / std::max<int64_t>(1, world.rows());
+}
+
+// The network part a parameter belongs to, by its registered path.
+std::string network_part(const std::string& name) {
+  const std::string head = name.substr(0, name.find('.'));
+  return "network." + (head == "unet" || head == "global" ? std::string("encoder") : head);
+}
+
+void clear_gradients(trainer::AvatarModel& model) {
+  for (const auto& name : trainer::Gaussians::parameter_names()) model.gaussians.parameter(name).mutable_grad() = at::Tensor();
+  for (auto& parameter : model.network->parameters()) parameter.mutable_grad() = at::Tensor();
+}
+
+std::vector<PartGradient> part_gradients(trainer::TrainedAvatar& avatar, const Dataset& dataset, int views) {
+  trainer::AvatarModel& model = avatar.model;
+  std::vector<std::pair<std::string, std::string>> pairs;  // (frame, camera) with an image
+  for (const auto& frame : dataset.train.frames)
+    for (const auto& camera : dataset.train.cameras)
+      if (dataset.has_image(camera, frame)) pairs.emplace_back(frame, camera);
+  if (pairs.empty() || views <= 0) return {};
+  const size_t count = std::min<size_t>(pairs.size(), size_t(views));
+  const at::Tensor background = at::tensor(avatar.options.background, at::kFloat).to(model.device());
+
+  std::map<std::string, double> sums;
+  const auto parameters = model.network->named_parameters(/*recurse=*/true);
+  // Gaussians built in code rather than loaded may not track gradients.
+  std::vector<bool> tracked;
+  for (const auto& name : trainer::Gaussians::parameter_names()) {
+    at::Tensor& p = model.gaussians.parameter(name);
+    tracked.push_back(p.requires_grad());
+    p.requires_grad_(true);
+  }
+  for (size_t i = 0; i < count; ++i) {
+    const auto& [frame, camera_name] = pairs[i * pairs.size() / count];
+    clear_gradients(model);
+
+    const trainer::FrameInput input = model.frame_input(dataset.load_mesh(frame), dataset.frame(frame).head_to_world);
+    const Camera& camera = dataset.rig.camera(camera_name);
+    const at::Tensor rendered =
+        trainer::render_view(model, input, camera, avatar.phase, background, avatar.options.antialiased);
+    const at::Tensor target = trainer::composite_target(
+        detail::read_rgba(dataset.image_path(camera_name, frame)).to(model.device()), background);
+    const at::Tensor loss = avatar.options.loss.l1 * nn::l1_image_loss(rendered, target) +
+                            avatar.options.loss.dssim * nn::dssim_loss(rendered, target);
+    loss.backward();
+
+    for (const auto& name : trainer::Gaussians::parameter_names()) {
+      const at::Tensor& grad = model.gaussians.parameter(name).grad();
+      sums["gaussians." + name] += grad.defined() ? grad.norm().item<double>() : 0.0;
+    }
+    std::map<std::string, double> squares;
+    for (const auto& item : parameters) {
+      const at::Tensor& grad = item.value().grad();
+      squares[network_part(item.key())] += grad.defined() ? grad.pow(2).sum().item<double>() : 0.0;
+    }
+    for (const auto& [part, square] : squares) sums[part] += std::sqrt(square);
+  }
+  clear_gradients(model);
+  for (size_t i = 0; i < tracked.size(); ++i)
+    model.gaussians.parameter(trainer::Gaussians::parameter_names()[i]).requires_grad_(tracked[i]);
+
+  std::vector<PartGradient> out;
+  for (const auto& [part, sum] : sums) out.push_back({part, sum / double(count)});
+  return out;
+}
+
+}  // namespace
+
+Liveness inspect_avatar(trainer::TrainedAvatar& avatar, const Dataset& dataset, const LivenessOptions& options) {
+  trainer::AvatarModel& model = avatar.model;
+  const trainer::Gaussians& g = model.gaussians;
+  Liveness out;
+  out.gaussians = g.size();
+  out.iteration = avatar.iteration;
+  out.deformation = avatar.phase.deformation;
+  out.shading = avatar.phase.shading;
+  trainer::Phase without_field = avatar.phase;
+  without_field.deformation = false;
+
+  std::vector<double> expression, deformation, shading_change;
+  at::Tensor shading_sum, shading_square_sum;
+  {
+    at::NoGradGuard no_grad;
+    for (const DatasetFrame& f : dataset.frames) {
+      const Vertices vertices = dataset.load_mesh(f.id);
+      const trainer::FrameInput input = model.frame_input(vertices, f.head_to_world);
+      FrameLiveness frame{f.id, expression_mm(vertices, f.head_to_world, dataset.template_mesh)};
+      if (out.deformation) {
+        const at::Tensor moved =
+            (model.pose(input, avatar.phase).means - model.pose(input, without_field).means).norm(2, 1) * 1000.0;
+        const at::Tensor moving = moved.index({moved > 1e-6});  // eyeballs stay put
+        frame.deformation_mean_mm = moving.numel() ? moving.mean().item<double>() : 0.0;
+        frame.deformation_p95_mm = quantile_of(moving, 0.95);
+      }
+      if (out.shading) {
+        const at::Tensor s = model.network->shade(g.uvd, model.network->encode(input.displacement_texture)).to(at::kDouble);
+        frame.shading_p01 = quantile_of(s, 0.01);
+        frame.shading_p50 = quantile_of(s, 0.5);
+        frame.shading_p99 = quantile_of(s, 0.99);
+        shading_sum = shading_sum.defined() ? shading_sum + s : s;
+        shading_square_sum = shading_square_sum.defined() ? shading_square_sum + s * s : s * s;
+        shading_change.push_back((s - 1.0).abs().mean().item<double>());
+      }
+      expression.push_back(frame.expression_mm);
+      deformation.push_back(frame.deformation_mean_mm);
+      out.frames.push_back(frame);
+    }
+    out.deformation_expression_r = out.deformation ? pearson(expression, deformation) : std::nan("");
+    out.shading_expression_r = out.shading ? pearson(expression, shading_change) : std::nan("");
+    if (shading_sum.defined()) {
+      const double n = double(dataset.frames.size());
+      const at::Tensor mean = shading_sum / n;
+      out.shading_frame_std = (shading_square_sum / n - mean * mean).clamp_min(0).sqrt().mean().item<double>();
+    }
+    if (g.birth_triangle.defined() && !g.rigged && !g.bound_triangle.defined()) {
+      const at::Tensor now = model.lookup().lookup(g.uvd.detach().slice(1, 0, 2)).triangle;
+      out.off_birth_triangle = now.ne(g.birth_triangle).to(at::kDouble).mean().item<double>();
+    }
+  }
+  out.gradients = part_gradients(avatar, dataset, options.gradient_views);
+  return out;
+}
+
+namespace {
+
+nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+std::string fixed(double v, int digits) {
+  if (!std::isfinite(v)) return "n/a";
+  char text[64];
+  std::snprintf(text, sizeof(text), "%.*f", digits, v);
+  return text;
+}
+
+std::string scientific(double v) {
+  char text[64];
+  std::snprintf(text, sizeof(text), "%.3g", v);
+  return text;
+}
+
+}  // namespace
+
+nlohmann::json liveness_json(const Liveness& l) {
+  nlohmann::json frames = nlohmann::json::array();
+  for (const auto& f : l.frames)
+    frames.push_back({{"frame", f.frame},
+                      {"expression_mm", f.expression_mm},
+                      {"deformation_mean_mm", f.deformation_mean_mm},
+                      {"deformation_p95_mm", f.deformation_p95_mm},
+                      {"shading_p01", f.shading_p01},
+                      {"shading_p50", f.shading_p50},
+                      {"shading_p99", f.shading_p99}});
+  nlohmann::json gradients = nlohmann::json::object();
+  for (const auto& g : l.gradients) gradients[g.part] = g.mean_norm;
+  return {{"format", "tega-inspect"},
+          {"version", 1},
+          {"gaussians", l.gaussians},
+          {"iteration", l.iteration},
+          {"deformation", l.deformation},
+          {"shading", l.shading},
+          {"deformation_expression_r", number(l.deformation_expression_r)},
+          {"shading_frame_std", l.shading ? number(l.shading_frame_std) : nlohmann::json(nullptr)},
+          {"shading_expression_r", number(l.shading_expression_r)},
+          {"off_birth_triangle", l.off_birth_triangle ? number(*l.off_birth_triangle) : nlohmann::json(nullptr)},
+          {"gradient_norms", gradients},
+          {"frames", frames}};
+}
+
+std::string liveness_markdown(const Liveness& l, const std::string& name) {
+  double deformation_mean = 0, deformation_p95 = 0, s_low = 1, s_high = 1;
+  for (const auto& f : l.frames) {
+    deformation_mean += f.deformation_mean_mm / double(l.frames.size());
+    deformation_p95 = std::max(deformation_p95, f.deformation_p95_mm);
+    s_low = std::min(s_low, f.shading_p01);
+    s_high = std::max(s_high, f.shading_p99);
+  }
+  std::string out = "## " + name + " (iteration " + std::to_string(l.iteration) + ", " +
+                    std::to_string(l.gaussians) + " Gaussians)\n\n";
+  out += l.deformation ? "- deformation field: mean |Δμ| " + fixed(deformation_mean, 3) + " mm over frames, largest p95 " +
+                             fixed(deformation_p95, 3) + " mm; r with the expression " +
+                             fixed(l.deformation_expression_r, 2) + "\n"
+                       : "- deformation field: off\n";
+  out += l.shading ? "- dynamic shading: S from " + fixed(s_low, 3) + " to " + fixed(s_high, 3) +
+                         " (p1..p99 over frames), per-Gaussian std over frames " + fixed(l.shading_frame_std, 4) +
+                         "; r of mean |S - 1| with the expression " + fixed(l.shading_expression_r, 2) + "\n"
+                   : "- dynamic shading: off\n";
+  out += l.off_birth_triangle ? "- Gaussians off the triangle they were created on: " +
+                                    fixed(100.0 * *l.off_birth_triangle, 2) + " %\n"
+                              : "- triangle changes: not tracked (bound Gaussians, or a checkpoint without birth triangles)\n";
+  out += "- mean gradient norm of L1 + D-SSIM per part:";
+  for (const auto& g : l.gradients) out += " " + g.part + " " + scientific(g.mean_norm) + ";";
+  out += "\n";
+  return out;
+}
+
+}  // namespace tega::tools
