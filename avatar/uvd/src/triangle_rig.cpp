@@ -36,8 +36,9 @@ UvdMapping rigged_to_world(const at::Tensor& local, const at::Tensor& triangle, 
   TORCH_CHECK(triangle.dim() == 1 && triangle.size(0) == local.size(0), "rigged_to_world: triangle must be [N]");
   TORCH_CHECK(local.scalar_type() == mesh.vertices.scalar_type(),
               "rigged_to_world: the local coordinates and the posed mesh must share a dtype");
+  // index_select checks the range itself; an explicit check would wait for
+  // the GPU on every training step.
   const at::Tensor index = triangle.to(at::kLong);
-  TORCH_CHECK(!((index < 0) | (index >= faces.size(0))).any().item<bool>(), "rigged_to_world: triangle out of range");
   const TriangleFrames frames = triangle_frames(mesh.vertices, faces);
   const at::Tensor jacobian =
       frames.rotation.index_select(0, index) * frames.scale.index_select(0, index).view({-1, 1, 1});
