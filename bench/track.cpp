@@ -150,6 +150,11 @@ int main(int argc, char** argv) {
                 "max %.3f deg\n",
                 1000 * s.vertex_median_m, 1000 * s.vertex_p95_m, s.rotation_median_deg, s.rotation_max_deg);
     for (const auto& [name, r] : s.correlation) std::printf("  %-16s r = %.3f\n", name.c_str(), r);
+    for (const tracking::ScoredFrame& frame : scored) {  // which frame a bad median or maximum comes from
+      const tracking::TrackScores f = tracking::score_frames({frame}, capture, "expressions");
+      std::printf("  frame %d: vertex error median %.3f mm, p95 %.3f mm; rotation error %.3f deg\n", frame.frame,
+                  1000 * f.vertex_median_m, 1000 * f.vertex_p95_m, f.rotation_median_deg);
+    }
   }
   return 0;
 }
