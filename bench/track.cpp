@@ -140,7 +140,7 @@ int main(int argc, char** argv) {
       std::printf("  %s %.2f", name.c_str(), scored.back().expression.at(name));
       if (fit.residuals.eyelids_covered.count(name)) std::printf(" (%.2f)", fit.residuals.eyelids_covered.at(name));
     }
-    std::printf("\n");
+    std::printf("%s\n", fit.fitted_afresh ? "  fitted afresh" : "");
     if (frame > 0) total += seconds, ++counted;  // frame 0 also finds the first pose
   }
   if (counted) std::printf("mean over frames 1..%d: %.2f s per frame (%d threads)\n", take.frames - 1, total / counted, threads);

@@ -22,6 +22,7 @@ fs::path frame_file(const fs::path& dir, int frame, const char* extension) {
 nlohmann::json residuals_json(const FrameResiduals& r) {
   nlohmann::json j = {{"surface_median_mm", 1000 * r.surface_median_m},
                       {"surface_p90_mm", 1000 * r.surface_p90_m},
+                      {"surface_capped_mean_mm", 1000 * r.surface_capped_mean_m},
                       {"inlier_fraction", r.inlier_fraction}};
   if (r.landmark_count > 0) j["landmark_rms_px"] = r.landmark_rms_px, j["landmarks"] = r.landmark_count;
   if (r.flow_count > 0) j["flow_rms_px"] = r.flow_rms_px, j["flow_points"] = r.flow_count;
@@ -33,6 +34,7 @@ FrameResiduals residuals_of(const nlohmann::json& j) {
   FrameResiduals r;
   r.surface_median_m = j.at("surface_median_mm").get<double>() / 1000;
   r.surface_p90_m = j.at("surface_p90_mm").get<double>() / 1000;
+  r.surface_capped_mean_m = j.value("surface_capped_mean_mm", -1000.0) / 1000;  // -1: a record from before it
   r.inlier_fraction = j.at("inlier_fraction");
   r.landmark_rms_px = j.value("landmark_rms_px", -1.0);
   r.landmark_count = j.value("landmarks", 0);
@@ -50,6 +52,7 @@ void write_frame_record(const fs::path& take_dir, const FrameRecord& record, con
   j["frame"] = record.frame;
   j["status"] = record.status;
   if (!record.reason.empty()) j["reason"] = record.reason;
+  if (record.fitted_afresh) j["fitted_afresh"] = true;
   if (record.status != "skipped") {
     const auto m = record.state.head_to_world.matrix();
     j["head_to_world"] = nlohmann::json::array();
@@ -85,7 +88,9 @@ std::optional<StoredFrame> read_frame_record(const fs::path& take_dir, int frame
       record.state.expression.push_back(tracked.expression.at(name));
     }
     try {
-      record.residuals = residuals_of(nlohmann::json::parse(read_text_file(file)).at("residuals"));
+      const nlohmann::json j = nlohmann::json::parse(read_text_file(file));
+      record.residuals = residuals_of(j.at("residuals"));
+      record.fitted_afresh = j.value("fitted_afresh", false);
     } catch (const nlohmann::json::exception& e) {
       throw Error(file, std::string("is not a valid frame record: ") + e.what());
     }

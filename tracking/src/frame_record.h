@@ -19,6 +19,7 @@ struct FrameRecord {
   std::string reason;  // why not tracked
   HeadState state;     // tracked or failed frames
   FrameResiduals residuals;
+  bool fitted_afresh = false;  // see FrameFit
 };
 
 void write_frame_record(const std::filesystem::path& take_dir, const FrameRecord& record, const Vertices* vertices,

@@ -72,6 +72,9 @@ void surface_residuals(const PosedModel& posed, const HeadModel& model, const Su
   residuals.inlier_fraction = double(distances.size()) / double(model.fit_vertices.size());
   residuals.surface_median_m = percentile(distances, 0.5);
   residuals.surface_p90_m = percentile(distances, 0.9);
+  double capped_sum = double(model.fit_vertices.size() - distances.size()) * options.final_distance_m;
+  for (const double d : distances) capped_sum += std::min(d, options.final_distance_m);
+  residuals.surface_capped_mean_m = capped_sum / double(std::max<size_t>(1, model.fit_vertices.size()));
 }
 
 std::vector<bool> visible_from(const Eigen::Vector3d& eye, const PosedModel& posed, const std::vector<int>& vertices,

@@ -1,5 +1,6 @@
 #include "tega/tracking/tracker.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -166,16 +167,16 @@ TakeTracker::TakeTracker(const HeadModel& model, const SubjectIdentity& subject,
 
 TakeTracker::~TakeTracker() = default;
 
-FrameFit TakeTracker::track(const FrameObservation& frame) {
+FrameFit TakeTracker::fit(const FrameObservation& frame, const Previous* previous) const {
   if (!frame.scan) throw Error("a frame to track needs its scan");
   const SurfaceQuery scan(*frame.scan);
   const Options& o = options_;
   const size_t E = model_.shapes.expression_deltas.size();
 
-  FrameFit fit;
-  HeadState& state = fit.state;
-  if (previous_) {
-    state = previous_->state;
+  FrameFit result;
+  HeadState& state = result.state;
+  if (previous) {
+    state = previous->state;
   } else {
     state.head_to_world = initial_pose(model_, subject_.neutral, frame, cameras_, o, landmarks_);
     state.expression.assign(E, 0.0);
@@ -187,14 +188,14 @@ FrameFit TakeTracker::track(const FrameObservation& frame) {
   std::vector<Term<ImageTarget>> image_terms;
   const bool has_images = !frame.images.empty();
   Term<ImageTarget> flow, landmarks;
-  if (o.flow.enabled && has_images && previous_ && previous_->scan)
-    flow = flow_targets(model_, previous_->posed, *previous_->scan, previous_->images, frame.images, cameras_, o.flow);
+  if (o.flow.enabled && has_images && previous && previous->scan)
+    flow = flow_targets(model_, previous->posed, *previous->scan, previous->images, frame.images, cameras_, o.flow);
   if (landmarks_ && has_images)
     landmarks = landmark_targets(model_, posed_model(model_, pose_vertices(model_, subject_, state)), frame, cameras_,
                                  scan, *landmarks_, o.landmarks);
   if (!flow.targets.empty()) image_terms.push_back(flow);
   if (!landmarks.targets.empty()) image_terms.push_back(landmarks);
-  fit.timings.image_terms_s = seconds_since(start);
+  result.timings.image_terms_s = seconds_since(start);
   start = std::chrono::steady_clock::now();
 
   // Coefficient priors: towards neutral, and towards the previous frame's
@@ -202,10 +203,10 @@ FrameFit TakeTracker::track(const FrameObservation& frame) {
   const CoefficientOptions& co = o.coefficients;
   std::vector<double> prior_mean(E, 0.0);
   double prior_sigma = co.expression_sigma;
-  if (previous_) {
+  if (previous) {
     const double a = 1 / (co.expression_sigma * co.expression_sigma);
     const double b = 1 / (co.expression_temporal_sigma * co.expression_temporal_sigma);
-    for (size_t j = 0; j < E; ++j) prior_mean[j] = b * previous_->state.expression[j] / (a + b);
+    for (size_t j = 0; j < E; ++j) prior_mean[j] = b * previous->state.expression[j] / (a + b);
     prior_sigma = 1 / std::sqrt(a + b);
   }
   std::vector<RigidTransform> poses = {state.head_to_world};
@@ -225,9 +226,9 @@ FrameFit TakeTracker::track(const FrameObservation& frame) {
       for (const auto& eye : observe_eyelids(*eyes_, model_, head, state, frame.images, cameras_,
                                              subject_.open_eyes_covered, o.eyelids)) {
         blinks.targets.push_back({eye.blink, eye.low, eye.high});
-        fit.residuals.eyelids_covered[model_.shapes.expression_names[size_t(eye.blink)]] = eye.covered;
+        result.residuals.eyelids_covered[model_.shapes.expression_names[size_t(eye.blink)]] = eye.covered;
       }
-      fit.timings.image_terms_s += seconds_since(started);
+      result.timings.image_terms_s += seconds_since(started);
     }
     CoefficientProblem p;
     p.base = &base;
@@ -243,7 +244,7 @@ FrameFit TakeTracker::track(const FrameObservation& frame) {
     p.frames.push_back({surface_targets(now, pose_only ? model_.pose_vertices : coefficient_vertices, scan, bound,
                                         o.surface),
                         pose_only ? std::vector<Term<ImageTarget>>{} : image_terms});
-    if (previous_) p.pose_priors.push_back(&previous_->state.head_to_world);
+    if (previous) p.pose_priors.push_back(&previous->state.head_to_world);
     p.rotation_sigma_rad = co.rotation_temporal_sigma_deg * kDegree;
     p.translation_sigma_m = co.translation_temporal_sigma_m;
     p.iterations = co.solver_iterations;
@@ -252,7 +253,7 @@ FrameFit TakeTracker::track(const FrameObservation& frame) {
     fit_coefficients(p, poses, state.expression);
     state.head_to_world = poses[0];
   }
-  fit.timings.coefficients_s = seconds_since(start);
+  result.timings.coefficients_s = seconds_since(start);
 
   start = std::chrono::steady_clock::now();
   if (o.corrections.enabled) {
@@ -261,7 +262,7 @@ FrameFit TakeTracker::track(const FrameObservation& frame) {
       const PosedModel now = posed_model(model_, pose_vertices(model_, subject_, state));
       CorrectionProblem p = correction_problem(model_.fit_vertices, o, fit_edges_, cameras_);
       p.base = &shaped;
-      p.previous = previous_ ? &previous_->state.corrections : nullptr;
+      p.previous = previous ? &previous->state.corrections : nullptr;
       p.poses = {state.head_to_world};
       p.frames.push_back(
           {surface_targets(now, model_.fit_vertices, scan, o.surface.final_distance_m, o.surface), image_terms});
@@ -269,14 +270,42 @@ FrameFit TakeTracker::track(const FrameObservation& frame) {
     }
   }
 
-  fit.timings.corrections_s = seconds_since(start);
-  fit.vertices = pose_vertices(model_, subject_, state);
-  surface_residuals(posed_model(model_, fit.vertices), model_, scan, o.surface, fit.residuals);
-  fit.residuals.flow_rms_px = reprojection_rms(flow, fit.vertices, cameras_);
-  fit.residuals.flow_count = int(flow.targets.size());
-  fit.residuals.landmark_rms_px = reprojection_rms(landmarks, fit.vertices, cameras_);
-  fit.residuals.landmark_count = int(landmarks.targets.size());
-  return fit;
+  result.timings.corrections_s = seconds_since(start);
+  result.vertices = pose_vertices(model_, subject_, state);
+  surface_residuals(posed_model(model_, result.vertices), model_, scan, o.surface, result.residuals);
+  result.residuals.flow_rms_px = reprojection_rms(flow, result.vertices, cameras_);
+  result.residuals.flow_count = int(flow.targets.size());
+  result.residuals.landmark_rms_px = reprojection_rms(landmarks, result.vertices, cameras_);
+  result.residuals.landmark_count = int(landmarks.targets.size());
+  return result;
+}
+
+FrameFit TakeTracker::track(const FrameObservation& frame) {
+  FrameFit warm = fit(frame, previous_.get());
+  if (!previous_ || (!rejection(warm) && !moved_far(warm))) return warm;
+  // A fast move or key poses far apart: ICP from the previous pose can
+  // settle on a face turned about the skull, which a fit from scratch avoids.
+  FrameFit fresh;
+  try {
+    fresh = fit(frame, nullptr);
+  } catch (const Error&) {  // no head where a first pose would be sought
+    return warm;
+  }
+  fresh.fitted_afresh = true;
+  FrameFit& kept = fresh.residuals.surface_capped_mean_m < warm.residuals.surface_capped_mean_m ? fresh : warm;
+  const FrameFit& other = &kept == &fresh ? warm : fresh;
+  kept.timings.image_terms_s += other.timings.image_terms_s;
+  kept.timings.coefficients_s += other.timings.coefficients_s;
+  kept.timings.corrections_s += other.timings.corrections_s;
+  return std::move(kept);
+}
+
+bool TakeTracker::moved_far(const FrameFit& fit) const {
+  const RigidTransform& from = previous_->state.head_to_world;
+  const RigidTransform& to = fit.state.head_to_world;
+  const double turn = Eigen::AngleAxisd(to.R * from.R.transpose()).angle();
+  const double shift = (to.t - from.t).norm();
+  return turn > options_.fresh_start.rotation_deg * kDegree || shift > options_.fresh_start.translation_m;
 }
 
 std::optional<std::string> TakeTracker::rejection(const FrameFit& fit) const {
@@ -311,8 +340,6 @@ void TakeTracker::resume_from(const HeadState& state) {
   previous_->state = state;
   previous_->posed = posed_model(model_, pose_vertices(model_, subject_, state));
 }
-
-void TakeTracker::forget() { previous_.reset(); }
 
 void TakeTracker::break_sequence() {
   if (!previous_) return;

@@ -102,17 +102,11 @@ void track_take(const TakeContext& t, const Options& options, TrackSummary& summ
     FrameObservation observation{&scan, {}};
     if (needs_photos(options, t.landmarks)) observation.images = frame_photos(t.take, frame, t.photo_factor, pool);
     if (!follows) tracker.break_sequence();
-    FrameFit fit = tracker.track(observation);
-    auto reason = tracker.rejection(fit);
-    // Too far from the frame it started from (after a gap, or a fast move):
-    // start afresh before giving up.
-    if (reason && tracker.has_previous()) {
-      tracker.forget();
-      fit = tracker.track(observation);
-      reason = tracker.rejection(fit);
-    }
+    const FrameFit fit = tracker.track(observation);
+    const auto reason = tracker.rejection(fit);
     record.state = fit.state;
     record.residuals = fit.residuals;
+    record.fitted_afresh = fit.fitted_afresh;
     if (reason) {
       record.status = "failed";
       record.reason = *reason;

@@ -179,6 +179,22 @@ struct CorrectionOptions {
   }
 };
 
+// When a frame is fitted a second time, from scratch: the warm-started fit
+// moved the head this far from the previous frame (a fast move, or frames
+// that are key poses rather than video).
+struct FreshStartOptions {
+  double rotation_deg = 2.0;
+  double translation_m = 0.005;
+
+  template <class V>
+  void visit(V& v) {
+    v("rotation_deg", rotation_deg,
+      "A frame whose fit turned the head more than this from the previous frame (degrees) is also fitted from a "
+      "fresh first pose and a neutral face; the fit nearer the scan is kept.");
+    v("translation_m", translation_m, "... or moved it more than this, metres.");
+  }
+};
+
 struct Options {
   std::string model;     // the head model directory
   std::string identity;  // an identity.json to reuse; empty: fit one
@@ -191,6 +207,7 @@ struct Options {
   CoefficientOptions coefficients;
   CorrectionOptions corrections;
   int icp_iterations = 5;
+  FreshStartOptions fresh_start;
   double min_inlier_fraction = 0.6;  // a frame whose fit vertices find the mesh less often fails
   double max_median_distance_m = 0.003;  // ... or whose median distance to it is larger
   int photo_max_side = 1536;            // the image terms read photos at a whole fraction of their size within this
@@ -213,6 +230,7 @@ struct Options {
     v("coefficients", coefficients, "Priors on the coefficients and the pose.");
     v("corrections", corrections, "Per-vertex corrections.");
     v("icp_iterations", icp_iterations, "Correspondence updates while fitting pose and coefficients.");
+    v("fresh_start", fresh_start, "When a frame is fitted again from scratch (besides when its fit is rejected).");
     v("min_inlier_fraction", min_inlier_fraction,
       "A frame fails (is recorded, not written) when fewer of its fit vertices than this find the mesh.");
     v("max_median_distance_m", max_median_distance_m,

@@ -44,6 +44,11 @@ struct HeadState {
 struct FrameResiduals {
   double surface_median_m = 0, surface_p90_m = 0;  // fit vertices to the scan, where they found it
   double inlier_fraction = 0;                     // fit vertices that found the scan
+  // Mean distance over all fit vertices, those that did not find the scan
+  // counted at the bound: one number that neither a fit holding fewer
+  // vertices nor one holding them loosely can win on (fits of a frame are
+  // compared by it).
+  double surface_capped_mean_m = 0;
   double landmark_rms_px = -1;                    // -1: no landmarks
   int landmark_count = 0;
   double flow_rms_px = -1;                        // -1: no flow
@@ -73,6 +78,7 @@ struct FrameFit {
   Vertices vertices;  // world space, the model's topology
   FrameResiduals residuals;
   FrameTimings timings;
+  bool fitted_afresh = false;  // from a fresh first pose, though an earlier frame was there to start from
 };
 
 // World-space vertices of the model in `state`.
@@ -99,8 +105,11 @@ class TakeTracker {
               const Options& options, const LandmarkDetector* landmarks);
   ~TakeTracker();
 
-  // Fits the next frame, warm-started from the last accepted one. The
-  // caller decides whether to accept() the fit (see acceptable()).
+  // Fits the next frame, warm-started from the last accepted one. Where
+  // that fit is rejected or has moved the head farther than
+  // options.fresh_start allows, the frame is fitted again from a fresh first
+  // pose and a neutral face, and the fit nearer the scan is returned. The
+  // caller decides whether to accept() it (see rejection()).
   FrameFit track(const FrameObservation& frame);
   // Whether a fit is good enough to keep; the reason when it is not.
   std::optional<std::string> rejection(const FrameFit& fit) const;
@@ -111,13 +120,13 @@ class TakeTracker {
   void resume_from(const HeadState& state);
   // The next frame does not follow the last accepted one (a gap): no flow.
   void break_sequence();
-  // Whether the next frame starts from an earlier one; forget() makes it
-  // start afresh, from initial_pose() and a neutral face.
-  bool has_previous() const { return previous_ != nullptr; }
-  void forget();
 
  private:
   struct Previous;
+  // One fit of the frame: from `previous`, or afresh (initial_pose() and a
+  // neutral face) where it is null.
+  FrameFit fit(const FrameObservation& frame, const Previous* previous) const;
+  bool moved_far(const FrameFit& fit) const;
   const HeadModel& model_;
   const SubjectIdentity& subject_;
   std::vector<Camera> cameras_;
