@@ -145,13 +145,14 @@ int main(int argc, char** argv) {
   }
   if (counted) std::printf("mean over frames 1..%d: %.2f s per frame (%d threads)\n", take.frames - 1, total / counted, threads);
   if (fs::exists(capture / "ground_truth")) {
-    const tracking::TrackScores s = tracking::score_frames(scored, capture, "expressions");
+    const tracking::TakeTruth truth(capture, "expressions");
+    const tracking::TrackScores s = truth.score(scored);
     std::printf("against the truth: vertex error median %.3f mm, p95 %.3f mm; rotation error median %.3f deg, "
                 "max %.3f deg\n",
                 1000 * s.vertex_median_m, 1000 * s.vertex_p95_m, s.rotation_median_deg, s.rotation_max_deg);
     for (const auto& [name, r] : s.correlation) std::printf("  %-16s r = %.3f\n", name.c_str(), r);
     for (const tracking::ScoredFrame& frame : scored) {  // which frame a bad median or maximum comes from
-      const tracking::TrackScores f = tracking::score_frames({frame}, capture, "expressions");
+      const tracking::TrackScores f = truth.score({frame});
       std::printf("  frame %d: vertex error median %.3f mm, p95 %.3f mm; rotation error %.3f deg\n", frame.frame,
                   1000 * f.vertex_median_m, 1000 * f.vertex_p95_m, f.rotation_median_deg);
     }

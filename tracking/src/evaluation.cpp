@@ -54,32 +54,38 @@ double pearson(const std::vector<double>& a, const std::vector<double>& b) {
 
 }  // namespace
 
-TrackScores score_frames(const std::vector<ScoredFrame>& tracked, const fs::path& capture, const std::string& take) {
-  const mvs::StudioTruth truth = mvs::load_studio_truth(capture, take, 0);
-  const auto frames = read_json(capture / "ground_truth" / take / "frames.json");
-  const Mesh coarse = read_obj(capture / "ground_truth" / "head" / "template.obj");
-  const std::vector<int> model_vertex = studio_model_vertices(capture);
-  std::map<int, const nlohmann::json*> truth_frames;
-  for (const auto& f : frames.at("frames")) truth_frames[f.at("index").get<int>()] = &f;
+TakeTruth::TakeTruth(const fs::path& capture, const std::string& take)
+    : frames_file_(capture / "ground_truth" / take / "frames.json"),
+      face_vertices_(mvs::load_studio_truth(capture, take, 0).face_vertices),
+      model_vertex_(studio_model_vertices(capture)) {
+  const int coarse_vertices = read_obj(capture / "ground_truth" / "head" / "template.obj").num_vertices();
+  const nlohmann::json frames = read_json(frames_file_);
+  for (const auto& f : frames.at("frames")) {
+    const int frame = f.at("index").get<int>();
+    rotation_[frame] = rotation_of(f.at("head_to_world"));
+    for (const auto& [expression, value] : f.at("expression").items()) expression_[frame][expression] = value.get<double>();
+    char name[32];
+    std::snprintf(name, sizeof name, "%06d.bin", frame);
+    coarse_[frame] = read_vertices_bin(capture / "ground_truth" / take / "coarse" / name, coarse_vertices);
+  }
+}
+
+TrackScores TakeTruth::score(const std::vector<ScoredFrame>& tracked) const {
   TrackScores scores;
   std::vector<double> errors, rotations;
   std::map<std::string, std::pair<std::vector<double>, std::vector<double>>> series;  // truth, tracked
   for (const ScoredFrame& t : tracked) {
-    if (!truth_frames.count(t.frame)) throw Error(capture / "ground_truth" / take / "frames.json", "has no frame " + std::to_string(t.frame));
-    const nlohmann::json& truth_frame = *truth_frames.at(t.frame);
-    char name[32];
-    std::snprintf(name, sizeof name, "%06d.bin", t.frame);
-    const Vertices true_mesh = read_vertices_bin(capture / "ground_truth" / take / "coarse" / name, coarse.num_vertices());
-    for (int v : truth.face_vertices) {
-      const int m = model_vertex[size_t(v)];
+    if (!rotation_.count(t.frame)) throw Error(frames_file_, "has no frame " + std::to_string(t.frame));
+    const Vertices& true_mesh = coarse_.at(t.frame);
+    for (int v : face_vertices_) {
+      const int m = model_vertex_[size_t(v)];
       if (m >= t.vertices.rows()) throw Error("a tracked mesh has fewer vertices than the studio's face region needs");
       errors.push_back((t.vertices.row(m) - true_mesh.row(v)).cast<double>().norm());
     }
-    const Eigen::Matrix3d R_true = rotation_of(truth_frame.at("head_to_world"));
-    rotations.push_back(Eigen::AngleAxisd(t.head_rotation.transpose() * R_true).angle() * 180 / M_PI);
-    for (const auto& [expression, value] : truth_frame.at("expression").items()) {
+    rotations.push_back(Eigen::AngleAxisd(t.head_rotation.transpose() * rotation_.at(t.frame)).angle() * 180 / M_PI);
+    for (const auto& [expression, value] : expression_.at(t.frame)) {
       auto& [truth_values, tracked_values] = series[expression];
-      truth_values.push_back(value.get<double>());
+      truth_values.push_back(value);
       tracked_values.push_back(t.expression.count(expression) ? t.expression.at(expression) : 0.0);
     }
     ++scores.frames;
@@ -108,7 +114,7 @@ TrackScores score_against_studio(const fs::path& tracked, const fs::path& captur
     scored.push_back({frame.frame, std::move(vertices), tracked_to_truth.R * frame.head_to_world.R, frame.expression});
   }
   if (scored.empty()) throw Error(tracked / take, "has no tracked frame to score");
-  return score_frames(scored, capture, take);
+  return TakeTruth(capture, take).score(scored);
 }
 
 }  // namespace tega::tracking

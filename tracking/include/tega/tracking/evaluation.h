@@ -42,8 +42,21 @@ struct ScoredFrame {
   std::map<std::string, double> expression;
 };
 
-TrackScores score_frames(const std::vector<ScoredFrame>& frames, const std::filesystem::path& capture,
-                         const std::string& take);
+// The truth of one take of a studio capture with ground_truth/, loaded once
+// to score any number of sets of tracked frames.
+class TakeTruth {
+ public:
+  TakeTruth(const std::filesystem::path& capture, const std::string& take);
+  TrackScores score(const std::vector<ScoredFrame>& frames) const;
+
+ private:
+  std::filesystem::path frames_file_;
+  std::vector<int> face_vertices_;       // the studio's face region, its head's numbering
+  std::vector<int> model_vertex_;        // the model's vertex of each of the studio head's
+  std::map<int, Eigen::Matrix3d> rotation_;                         // by frame
+  std::map<int, std::map<std::string, double>> expression_;        // by frame
+  std::map<int, Vertices> coarse_;                                  // by frame: the true mesh
+};
 
 // The tracked frames of TRACKED/<take>; `capture`: the studio's capture with ground_truth/.
 // `tracked_to_truth` moves the tracked meshes and poses from the world of the rig tracking used (a
