@@ -146,10 +146,12 @@ int main(int argc, char** argv) {
   if (counted) std::printf("mean over frames 1..%d: %.2f s per frame (%d threads)\n", take.frames - 1, total / counted, threads);
   if (fs::exists(capture / "ground_truth")) {
     const tracking::TakeTruth truth(capture, "expressions");
-    const tracking::TrackScores s = truth.score(scored);
+    const tracking::TrackScores s = truth.score(scored, &subject.neutral);
     std::printf("against the truth: vertex error median %.3f mm, p95 %.3f mm; rotation error median %.3f deg, "
-                "max %.3f deg\n",
-                1000 * s.vertex_median_m, 1000 * s.vertex_p95_m, s.rotation_median_deg, s.rotation_max_deg);
+                "max %.3f deg (%.3f deg with the fitted subject aligned to the true one, which it is turned %.3f deg "
+                "from)\n",
+                1000 * s.vertex_median_m, 1000 * s.vertex_p95_m, s.rotation_median_deg, s.rotation_max_deg,
+                s.rotation_aligned_median_deg, s.subject_rotation_deg);
     for (const auto& [name, r] : s.correlation) std::printf("  %-16s r = %.3f\n", name.c_str(), r);
     for (const tracking::ScoredFrame& frame : scored) {  // which frame a bad median or maximum comes from
       const tracking::TrackScores f = truth.score({frame});

@@ -5,12 +5,14 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
 #include "pipeline_test_support.h"
 #include "tega/core/files.h"
 #include "tega/core/image.h"
+#include "tega/core/mesh.h"
 #include "tega/core/rig.h"
 #include "tega/pipeline/manifest.h"
 #include "test_support.h"
@@ -191,6 +193,36 @@ void commit_by_hand(const fs::path& shard, const std::string& stage, const std::
   pipeline::Manifest manifest;
   manifest.stage = stage, manifest.shard = shard.filename().string(), manifest.kind = kind;
   pipeline::write_manifest(shard / "manifest.json", manifest);
+}
+
+// A tracked subject turned 1 degree from the true one in head space, its
+// poses turned back so that every world mesh stays the truth's: the raw
+// rotation error is that degree, the error with the subject aligned none.
+TEST_F(ReportStudio, TheFittedSubjectsTurnIsScoredApartFromThePose) {
+  const fs::path capture = workspace() / "synth/alice/capture";
+  TempDir dir;
+  const fs::path tracked = dir / "tracked";
+  tracking::write_studio_truth_as_tracked(capture, tracked);
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(M_PI / 180, Eigen::Vector3d(1, 0.3, 0).normalized()).matrix();
+  Mesh neutral = read_obj(tracked / "identity_neutral.obj");
+  neutral.positions = (neutral.positions.cast<double>() * turn.transpose()).cast<float>();
+  write_obj(neutral, tracked / "identity_neutral.obj");
+  for (const auto& entry : fs::directory_iterator(tracked / "expressions")) {
+    if (entry.path().extension() != ".json" || entry.path().filename() == "track.json") continue;
+    json record = json::parse(read_text_file(entry.path()));
+    Eigen::Matrix3d R;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) R(r, c) = record["head_to_world"][r][c];
+    const Eigen::Matrix3d turned_back = R * turn.transpose();
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) record["head_to_world"][r][c] = turned_back(r, c);
+    write_text(entry.path(), record.dump());
+  }
+  const tracking::TrackScores s = tracking::score_against_studio(tracked, capture, "expressions");
+  EXPECT_NEAR(s.rotation_median_deg, 1.0, 1e-3);
+  EXPECT_NEAR(s.subject_rotation_deg, 1.0, 1e-3);
+  EXPECT_LT(s.rotation_aligned_median_deg, 1e-3);
+  EXPECT_LT(s.vertex_median_m, 1e-6);
 }
 
 // The studio's own truth as the tracked meshes and the mattes (tracking and

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "tega/core/error.h"
 #include "tega/core/files.h"
@@ -58,7 +59,8 @@ TakeTruth::TakeTruth(const fs::path& capture, const std::string& take)
     : frames_file_(capture / "ground_truth" / take / "frames.json"),
       face_vertices_(mvs::load_studio_truth(capture, take, 0).face_vertices),
       model_vertex_(studio_model_vertices(capture)) {
-  const int coarse_vertices = read_obj(capture / "ground_truth" / "head" / "template.obj").num_vertices();
+  neutral_ = read_obj(capture / "ground_truth" / "head" / "template.obj").positions;
+  const int coarse_vertices = int(neutral_.rows());
   const nlohmann::json frames = read_json(frames_file_);
   for (const auto& f : frames.at("frames")) {
     const int frame = f.at("index").get<int>();
@@ -70,9 +72,22 @@ TakeTruth::TakeTruth(const fs::path& capture, const std::string& take)
   }
 }
 
-TrackScores TakeTruth::score(const std::vector<ScoredFrame>& tracked) const {
+TrackScores TakeTruth::score(const std::vector<ScoredFrame>& tracked, const Vertices* subject_neutral) const {
   TrackScores scores;
-  std::vector<double> errors, rotations;
+  // The fitted neutral ~ subject_turn * true neutral + a shift, in head space.
+  std::optional<Eigen::Matrix3d> subject_turn;
+  if (subject_neutral) {
+    Eigen::Matrix3Xd truth_points(3, face_vertices_.size()), fitted_points(3, face_vertices_.size());
+    for (size_t i = 0; i < face_vertices_.size(); ++i) {
+      const int v = face_vertices_[i], m = model_vertex_[size_t(v)];
+      if (m >= subject_neutral->rows()) throw Error("the subject's neutral has fewer vertices than the studio's face region needs");
+      truth_points.col(Eigen::Index(i)) = neutral_.row(v).cast<double>().transpose();
+      fitted_points.col(Eigen::Index(i)) = subject_neutral->row(m).cast<double>().transpose();
+    }
+    subject_turn = Eigen::umeyama(truth_points, fitted_points, false).topLeftCorner<3, 3>();
+    scores.subject_rotation_deg = Eigen::AngleAxisd(*subject_turn).angle() * 180 / M_PI;
+  }
+  std::vector<double> errors, rotations, aligned_rotations;
   std::map<std::string, std::pair<std::vector<double>, std::vector<double>>> series;  // truth, tracked
   for (const ScoredFrame& t : tracked) {
     if (!rotation_.count(t.frame)) throw Error(frames_file_, "has no frame " + std::to_string(t.frame));
@@ -82,7 +97,11 @@ TrackScores TakeTruth::score(const std::vector<ScoredFrame>& tracked) const {
       if (m >= t.vertices.rows()) throw Error("a tracked mesh has fewer vertices than the studio's face region needs");
       errors.push_back((t.vertices.row(m) - true_mesh.row(v)).cast<double>().norm());
     }
-    rotations.push_back(Eigen::AngleAxisd(t.head_rotation.transpose() * rotation_.at(t.frame)).angle() * 180 / M_PI);
+    const Eigen::Matrix3d& R_true = rotation_.at(t.frame);
+    rotations.push_back(Eigen::AngleAxisd(t.head_rotation.transpose() * R_true).angle() * 180 / M_PI);
+    if (subject_turn)
+      aligned_rotations.push_back(
+          Eigen::AngleAxisd((t.head_rotation * *subject_turn).transpose() * R_true).angle() * 180 / M_PI);
     for (const auto& [expression, value] : expression_.at(t.frame)) {
       auto& [truth_values, tracked_values] = series[expression];
       truth_values.push_back(value);
@@ -95,6 +114,7 @@ TrackScores TakeTruth::score(const std::vector<ScoredFrame>& tracked) const {
   scores.vertex_p95_m = percentile(errors, 0.95);
   scores.rotation_median_deg = percentile(rotations, 0.5);
   scores.rotation_max_deg = *std::max_element(rotations.begin(), rotations.end());
+  if (subject_turn) scores.rotation_aligned_median_deg = percentile(aligned_rotations, 0.5);
   for (const auto& [expression, values] : series) {
     const auto& truth_values = values.first;
     if (*std::max_element(truth_values.begin(), truth_values.end()) - *std::min_element(truth_values.begin(), truth_values.end()) > 0.1)
@@ -114,7 +134,10 @@ TrackScores score_against_studio(const fs::path& tracked, const fs::path& captur
     scored.push_back({frame.frame, std::move(vertices), tracked_to_truth.R * frame.head_to_world.R, frame.expression});
   }
   if (scored.empty()) throw Error(tracked / take, "has no tracked frame to score");
-  return TakeTruth(capture, take).score(scored);
+  const fs::path neutral_file = tracked / "identity_neutral.obj";
+  if (!fs::exists(neutral_file)) return TakeTruth(capture, take).score(scored);
+  const Vertices neutral = read_obj(neutral_file).positions;
+  return TakeTruth(capture, take).score(scored, &neutral);
 }
 
 }  // namespace tega::tracking

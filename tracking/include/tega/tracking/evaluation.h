@@ -6,6 +6,7 @@
 // see-through eye overlays (which it removes), where the face lies.
 
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -20,6 +21,14 @@ struct TrackScores {
   int frames = 0;                         // tracked frames scored
   double vertex_median_m = 0, vertex_p95_m = 0;  // over the face region's vertices of every scored frame
   double rotation_median_deg = 0, rotation_max_deg = 0;
+  // With the fitted subject's neutral (NaN without one): how far it is
+  // turned from the true neutral in head space (their rigid alignment over
+  // the face region), and the head rotation error once that turn is taken
+  // out. A head model whose identity shapes turn the face (ICT-FaceKit's
+  // do) reports every error of the fitted identity as a turn of the head
+  // too; this separates the two.
+  double subject_rotation_deg = std::numeric_limits<double>::quiet_NaN();
+  double rotation_aligned_median_deg = std::numeric_limits<double>::quiet_NaN();
   std::map<std::string, double> correlation;  // per true expression that varies: Pearson r over the frames
 };
 
@@ -47,18 +56,21 @@ struct ScoredFrame {
 class TakeTruth {
  public:
   TakeTruth(const std::filesystem::path& capture, const std::string& take);
-  TrackScores score(const std::vector<ScoredFrame>& frames) const;
+  // `subject_neutral`: the tracked subject's neutral (head space, the model's topology), or null.
+  TrackScores score(const std::vector<ScoredFrame>& frames, const Vertices* subject_neutral = nullptr) const;
 
  private:
   std::filesystem::path frames_file_;
   std::vector<int> face_vertices_;       // the studio's face region, its head's numbering
   std::vector<int> model_vertex_;        // the model's vertex of each of the studio head's
+  Vertices neutral_;                     // the true subject's neutral, head space, the studio head's numbering
   std::map<int, Eigen::Matrix3d> rotation_;                         // by frame
   std::map<int, std::map<std::string, double>> expression_;        // by frame
   std::map<int, Vertices> coarse_;                                  // by frame: the true mesh
 };
 
-// The tracked frames of TRACKED/<take>; `capture`: the studio's capture with ground_truth/.
+// The tracked frames of TRACKED/<take> (and the subject of TRACKED/identity_neutral.obj,
+// where there is one); `capture`: the studio's capture with ground_truth/.
 // `tracked_to_truth` moves the tracked meshes and poses from the world of the rig tracking used (a
 // calibrated rig has its own, its first camera's by default) into the studio's.
 TrackScores score_against_studio(const std::filesystem::path& tracked, const std::filesystem::path& capture,
