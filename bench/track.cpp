@@ -148,13 +148,13 @@ int main(int argc, char** argv) {
     const tracking::TakeTruth truth(capture, "expressions");
     const tracking::TrackScores s = truth.score(scored, &subject.neutral);
     std::printf("against the truth: vertex error median %.3f mm, p95 %.3f mm; rotation error median %.3f deg, "
-                "max %.3f deg (%.3f deg with the fitted subject aligned to the true one, which it is turned %.3f deg "
-                "from)\n",
+                "max %.3f deg (the fitted subject is turned %.3f deg from the true one; without that taken out the "
+                "poses are %.3f deg off)\n",
                 1000 * s.vertex_median_m, 1000 * s.vertex_p95_m, s.rotation_median_deg, s.rotation_max_deg,
-                s.rotation_aligned_median_deg, s.subject_rotation_deg);
+                s.subject_rotation_deg, s.pose_rotation_median_deg);
     for (const auto& [name, r] : s.correlation) std::printf("  %-16s r = %.3f\n", name.c_str(), r);
     for (const tracking::ScoredFrame& frame : scored) {  // which frame a bad median or maximum comes from
-      const tracking::TrackScores f = truth.score({frame});
+      const tracking::TrackScores f = truth.score({frame}, &subject.neutral);
       std::printf("  frame %d: vertex error median %.3f mm, p95 %.3f mm; rotation error %.3f deg\n", frame.frame,
                   1000 * f.vertex_median_m, 1000 * f.vertex_p95_m, f.rotation_median_deg);
     }

@@ -97,11 +97,11 @@ void score_take(const std::string& stage, const fs::path& tracked, const std::st
   add("vertex error median", 1000 * s.vertex_median_m, 2, " mm", 1.0, true);
   add("vertex error p95", 1000 * s.vertex_p95_m, 2, " mm", 3.0, true);
   add("head rotation error median", s.rotation_median_deg, 2, " deg", 0.5, true);
-  // Diagnostics without a target: how much of that is the fitted subject's own turn.
+  // Diagnostics without a target: the turn the rotation error leaves out.
   if (std::isfinite(s.subject_rotation_deg)) {
-    for (const auto& [measure, value] : {std::pair{"fitted subject's turn from the true one", s.subject_rotation_deg},
-                                         std::pair{"head rotation error median, subject aligned",
-                                                   s.rotation_aligned_median_deg}}) {
+    for (const auto& [measure, value] :
+         {std::pair{"fitted subject's turn from the true one", s.subject_rotation_deg},
+          std::pair{"head pose rotation error median, each subject's own head frame", s.pose_rotation_median_deg}}) {
       table.rows.push_back({measure, fixed(value, 2) + " deg", ""});
       context.scores.push_back({stage + " (" + take + ")", measure, fixed(value, 2) + " deg", "", ""});
     }

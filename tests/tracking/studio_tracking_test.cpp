@@ -80,12 +80,14 @@ void expect_eyelids_seen(const fs::path& tracked_take, const fs::path& capture) 
   EXPECT_GT(least_closed, most_open + 0.3);
 }
 
-// The true fine meshes as the scans (what a perfect MVS would give).
 // TRACKED/<take> as tracking with a rig in another world would have written it:
 // every mesh and head pose moved by `world_change`.
 void move_tracked_take(const fs::path& from, const fs::path& to, const RigidTransform& world_change) {
   fs::create_directories(to.parent_path());
   fs::copy(from, to, fs::copy_options::recursive);
+  // The subject lies in head space, the same in any world.
+  fs::copy_file(from.parent_path() / "identity_neutral.obj", to.parent_path() / "identity_neutral.obj",
+                fs::copy_options::overwrite_existing);
   for (const auto& file : fs::directory_iterator(to)) {
     if (file.path().extension() != ".json" || file.path().filename() == "track.json") continue;
     auto record = nlohmann::json::parse(read_text_file(file.path()));
@@ -104,6 +106,7 @@ void move_tracked_take(const fs::path& from, const fs::path& to, const RigidTran
   }
 }
 
+// The true fine meshes as the scans (what a perfect MVS would give).
 void write_true_scans(const fs::path& capture, const fs::path& meshes) {
   Mesh fine = read_obj(capture / "ground_truth" / "head" / "fine_topology.obj");
   fine.uvs.resize(0, 2);

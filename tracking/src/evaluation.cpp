@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
-#include <optional>
 
 #include "tega/core/error.h"
 #include "tega/core/files.h"
@@ -75,7 +74,7 @@ TakeTruth::TakeTruth(const fs::path& capture, const std::string& take)
 TrackScores TakeTruth::score(const std::vector<ScoredFrame>& tracked, const Vertices* subject_neutral) const {
   TrackScores scores;
   // The fitted neutral ~ subject_turn * true neutral + a shift, in head space.
-  std::optional<Eigen::Matrix3d> subject_turn;
+  Eigen::Matrix3d subject_turn = Eigen::Matrix3d::Identity();
   if (subject_neutral) {
     Eigen::Matrix3Xd truth_points(3, face_vertices_.size()), fitted_points(3, face_vertices_.size());
     for (size_t i = 0; i < face_vertices_.size(); ++i) {
@@ -85,9 +84,9 @@ TrackScores TakeTruth::score(const std::vector<ScoredFrame>& tracked, const Vert
       fitted_points.col(Eigen::Index(i)) = subject_neutral->row(m).cast<double>().transpose();
     }
     subject_turn = Eigen::umeyama(truth_points, fitted_points, false).topLeftCorner<3, 3>();
-    scores.subject_rotation_deg = Eigen::AngleAxisd(*subject_turn).angle() * 180 / M_PI;
+    scores.subject_rotation_deg = Eigen::AngleAxisd(subject_turn).angle() * 180 / M_PI;
   }
-  std::vector<double> errors, rotations, aligned_rotations;
+  std::vector<double> errors, rotations, pose_rotations;
   std::map<std::string, std::pair<std::vector<double>, std::vector<double>>> series;  // truth, tracked
   for (const ScoredFrame& t : tracked) {
     if (!rotation_.count(t.frame)) throw Error(frames_file_, "has no frame " + std::to_string(t.frame));
@@ -98,10 +97,8 @@ TrackScores TakeTruth::score(const std::vector<ScoredFrame>& tracked, const Vert
       errors.push_back((t.vertices.row(m) - true_mesh.row(v)).cast<double>().norm());
     }
     const Eigen::Matrix3d& R_true = rotation_.at(t.frame);
-    rotations.push_back(Eigen::AngleAxisd(t.head_rotation.transpose() * R_true).angle() * 180 / M_PI);
-    if (subject_turn)
-      aligned_rotations.push_back(
-          Eigen::AngleAxisd((t.head_rotation * *subject_turn).transpose() * R_true).angle() * 180 / M_PI);
+    rotations.push_back(Eigen::AngleAxisd((t.head_rotation * subject_turn).transpose() * R_true).angle() * 180 / M_PI);
+    pose_rotations.push_back(Eigen::AngleAxisd(t.head_rotation.transpose() * R_true).angle() * 180 / M_PI);
     for (const auto& [expression, value] : expression_.at(t.frame)) {
       auto& [truth_values, tracked_values] = series[expression];
       truth_values.push_back(value);
@@ -114,7 +111,7 @@ TrackScores TakeTruth::score(const std::vector<ScoredFrame>& tracked, const Vert
   scores.vertex_p95_m = percentile(errors, 0.95);
   scores.rotation_median_deg = percentile(rotations, 0.5);
   scores.rotation_max_deg = *std::max_element(rotations.begin(), rotations.end());
-  if (subject_turn) scores.rotation_aligned_median_deg = percentile(aligned_rotations, 0.5);
+  if (subject_neutral) scores.pose_rotation_median_deg = percentile(pose_rotations, 0.5);
   for (const auto& [expression, values] : series) {
     const auto& truth_values = values.first;
     if (*std::max_element(truth_values.begin(), truth_values.end()) - *std::min_element(truth_values.begin(), truth_values.end()) > 0.1)

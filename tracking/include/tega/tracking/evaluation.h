@@ -20,15 +20,19 @@ namespace tega::tracking {
 struct TrackScores {
   int frames = 0;                         // tracked frames scored
   double vertex_median_m = 0, vertex_p95_m = 0;  // over the face region's vertices of every scored frame
+  // How far the tracked head is turned from the true head: head_to_world
+  // against the truth's in one head frame, the fitted subject's neutral
+  // rigidly aligned onto the true one over the face region (without a fitted
+  // neutral, each pose as it is). A head's pose is relative to its subject's
+  // neutral, and a head model whose identity shapes turn the face
+  // (ICT-FaceKit's do) would otherwise report every error of the fitted
+  // identity coefficients as a turn of every pose, one the meshes do not have.
   double rotation_median_deg = 0, rotation_max_deg = 0;
-  // With the fitted subject's neutral (NaN without one): how far it is
-  // turned from the true neutral in head space (their rigid alignment over
-  // the face region), and the head rotation error once that turn is taken
-  // out. A head model whose identity shapes turn the face (ICT-FaceKit's
-  // do) reports every error of the fitted identity as a turn of the head
-  // too; this separates the two.
+  // With the fitted neutral (NaN without one): the turn that alignment
+  // takes out, and the poses' error as they are, each relative to its own
+  // subject's neutral.
   double subject_rotation_deg = std::numeric_limits<double>::quiet_NaN();
-  double rotation_aligned_median_deg = std::numeric_limits<double>::quiet_NaN();
+  double pose_rotation_median_deg = std::numeric_limits<double>::quiet_NaN();
   std::map<std::string, double> correlation;  // per true expression that varies: Pearson r over the frames
 };
 
