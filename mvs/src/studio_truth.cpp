@@ -67,7 +67,8 @@ std::vector<int> cameras_seeing(const Mesh& mesh, const std::vector<int>& faces,
 
 }  // namespace
 
-StudioTruth load_studio_truth(const std::filesystem::path& capture, const std::string& take, int frame) {
+StudioTruthSource::StudioTruthSource(const std::filesystem::path& capture)
+    : capture_(capture), rig_(read_rig_json(capture / "rig.json")) {
   const auto head_dir = capture / "ground_truth" / "head";
   const auto head_file = head_dir / "head.json";
   nlohmann::json head;
@@ -76,36 +77,44 @@ StudioTruth load_studio_truth(const std::filesystem::path& capture, const std::s
   } catch (const nlohmann::json::exception& e) {
     throw Error(head_file, std::string("is not valid JSON: ") + e.what());
   }
-  const Mesh coarse = read_obj(head_dir / "template.obj");
+  coarse_ = read_obj(head_dir / "template.obj");
+  fine_ = read_obj(head_dir / "fine_topology.obj");
+  // Subdivision emits each coarse triangle's fine triangles as one run, in order.
+  run_ = coarse_.num_faces() > 0 ? fine_.num_faces() / coarse_.num_faces() : 0;
+  if (run_ == 0 || run_ * coarse_.num_faces() != fine_.num_faces())
+    throw Error(head_dir / "fine_topology.obj", "does not subdivide template.obj (" +
+                                                   std::to_string(fine_.num_faces()) + " triangles for " +
+                                                   std::to_string(coarse_.num_faces()) + ")");
+  const std::vector<bool> region = coarse_face_region(coarse_, head);
+  for (int f = 0; f < fine_.num_faces(); ++f)
+    if (region[size_t(f / run_)]) box_.push_back(f);
+}
+
+StudioTruth StudioTruthSource::frame(const std::string& take, int frame) const {
   StudioTruth truth;
-  truth.fine = read_obj(head_dir / "fine_topology.obj");
+  truth.fine = fine_;
   char name[32];
   std::snprintf(name, sizeof name, "%06d.bin", frame);
-  truth.fine.positions = read_vertices_bin(capture / "ground_truth" / take / "fine" / name, truth.fine.num_vertices());
-
-  // Subdivision emits each coarse triangle's fine triangles as one run, in order.
-  const std::vector<bool> region = coarse_face_region(coarse, head);
-  const int run = coarse.num_faces() > 0 ? truth.fine.num_faces() / coarse.num_faces() : 0;
-  if (run == 0 || run * coarse.num_faces() != truth.fine.num_faces())
-    throw Error(head_dir / "fine_topology.obj", "does not subdivide template.obj (" +
-                                                   std::to_string(truth.fine.num_faces()) + " triangles for " +
-                                                   std::to_string(coarse.num_faces()) + ")");
-  std::vector<int> box;
-  for (int f = 0; f < truth.fine.num_faces(); ++f)
-    if (region[size_t(f / run)]) box.push_back(f);
+  truth.fine.positions = read_vertices_bin(capture_ / "ground_truth" / take / "fine" / name, fine_.num_vertices());
   // The box also holds what no camera can see (a closed mouth's teeth and
   // socket, the eye sockets behind the eyeballs): stereo needs two views.
-  const Rig rig = read_rig_json(capture / "rig.json");
-  const std::vector<int> seen = cameras_seeing(truth.fine, box, rig);
-  for (size_t i = 0; i < box.size(); ++i)
-    if (seen[i] >= 2) truth.face_region.push_back(box[i]);
-  std::vector<char> in_region(size_t(coarse.num_vertices()), 0);
-  for (int f = 0; f < coarse.num_faces(); ++f)
-    if (region[size_t(f)])
-      for (int k = 0; k < 3; ++k) in_region[size_t(coarse.faces(f, k))] = 1;
-  for (int v = 0; v < coarse.num_vertices(); ++v)
+  const std::vector<int> seen = cameras_seeing(truth.fine, box_, rig_);
+  for (size_t i = 0; i < box_.size(); ++i)
+    if (seen[i] >= 2) truth.face_region.push_back(box_[i]);
+  // A coarse triangle is seen where most of its fine ones are.
+  std::vector<int> seen_fine(size_t(coarse_.num_faces()), 0);
+  for (int f : truth.face_region) ++seen_fine[size_t(f / run_)];
+  std::vector<char> in_region(size_t(coarse_.num_vertices()), 0);
+  for (int f = 0; f < coarse_.num_faces(); ++f)
+    if (2 * seen_fine[size_t(f)] > run_)
+      for (int k = 0; k < 3; ++k) in_region[size_t(coarse_.faces(f, k))] = 1;
+  for (int v = 0; v < coarse_.num_vertices(); ++v)
     if (in_region[size_t(v)]) truth.face_vertices.push_back(v);
   return truth;
+}
+
+StudioTruth load_studio_truth(const std::filesystem::path& capture, const std::string& take, int frame) {
+  return StudioTruthSource(capture).frame(take, frame);
 }
 
 }  // namespace tega::mvs

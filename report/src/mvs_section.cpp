@@ -89,12 +89,13 @@ void score_meshes(const std::string& stage, const fs::path& meshes,
   options.tolerances_m = {0.001, 0.002, 0.003};
   Table table{{"take", "frame", "accuracy median mm", "accuracy p90 mm", "within 1 / 2 / 3 mm %"}, {}};
   std::vector<double> accuracies, completeness;
+  const mvs::StudioTruthSource studio(context.subject.truth);
   for (const auto& [take, records] : takes) {
     for (size_t i : spread(records.size(), size_t(context.options.scored_frames_per_take))) {
       const int frame = records[i].frame;
       char name[16];
       std::snprintf(name, sizeof name, "%06d.ply", frame);
-      const mvs::StudioTruth truth = mvs::load_studio_truth(context.subject.truth, take, frame);
+      const mvs::StudioTruth truth = studio.frame(take, frame);
       Mesh mesh = read_mesh(meshes / take / name);
       for (int v = 0; v < mesh.positions.rows(); ++v)
         mesh.positions.row(v) =

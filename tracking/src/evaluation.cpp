@@ -56,7 +56,8 @@ double pearson(const std::vector<double>& a, const std::vector<double>& b) {
 
 TakeTruth::TakeTruth(const fs::path& capture, const std::string& take)
     : frames_file_(capture / "ground_truth" / take / "frames.json"),
-      face_vertices_(mvs::load_studio_truth(capture, take, 0).face_vertices),
+      take_(take),
+      studio_(std::make_unique<mvs::StudioTruthSource>(capture)),
       model_vertex_(studio_model_vertices(capture)) {
   neutral_ = read_obj(capture / "ground_truth" / "head" / "template.obj").positions;
   const int coarse_vertices = int(neutral_.rows());
@@ -69,6 +70,16 @@ TakeTruth::TakeTruth(const fs::path& capture, const std::string& take)
     std::snprintf(name, sizeof name, "%06d.bin", frame);
     coarse_[frame] = read_vertices_bin(capture / "ground_truth" / take / "coarse" / name, coarse_vertices);
   }
+  if (rotation_.empty()) throw Error(frames_file_, "lists no frame");
+}
+
+TakeTruth::~TakeTruth() = default;
+
+const std::vector<int>& TakeTruth::face_vertices(int frame) const {
+  auto found = face_vertices_.find(frame);
+  if (found == face_vertices_.end())
+    found = face_vertices_.emplace(frame, studio_->frame(take_, frame).face_vertices).first;
+  return found->second;
 }
 
 TrackScores TakeTruth::score(const std::vector<ScoredFrame>& tracked, const Vertices* subject_neutral) const {
@@ -76,9 +87,10 @@ TrackScores TakeTruth::score(const std::vector<ScoredFrame>& tracked, const Vert
   // The fitted neutral ~ subject_turn * true neutral + a shift, in head space.
   Eigen::Matrix3d subject_turn = Eigen::Matrix3d::Identity();
   if (subject_neutral) {
-    Eigen::Matrix3Xd truth_points(3, face_vertices_.size()), fitted_points(3, face_vertices_.size());
-    for (size_t i = 0; i < face_vertices_.size(); ++i) {
-      const int v = face_vertices_[i], m = model_vertex_[size_t(v)];
+    const std::vector<int>& face = face_vertices(rotation_.begin()->first);
+    Eigen::Matrix3Xd truth_points(3, face.size()), fitted_points(3, face.size());
+    for (size_t i = 0; i < face.size(); ++i) {
+      const int v = face[i], m = model_vertex_[size_t(v)];
       if (m >= subject_neutral->rows()) throw Error("the subject's neutral has fewer vertices than the studio's face region needs");
       truth_points.col(Eigen::Index(i)) = neutral_.row(v).cast<double>().transpose();
       fitted_points.col(Eigen::Index(i)) = subject_neutral->row(m).cast<double>().transpose();
@@ -91,7 +103,7 @@ TrackScores TakeTruth::score(const std::vector<ScoredFrame>& tracked, const Vert
   for (const ScoredFrame& t : tracked) {
     if (!rotation_.count(t.frame)) throw Error(frames_file_, "has no frame " + std::to_string(t.frame));
     const Vertices& true_mesh = coarse_.at(t.frame);
-    for (int v : face_vertices_) {
+    for (int v : face_vertices(t.frame)) {
       const int m = model_vertex_[size_t(v)];
       if (m >= t.vertices.rows()) throw Error("a tracked mesh has fewer vertices than the studio's face region needs");
       errors.push_back((t.vertices.row(m) - true_mesh.row(v)).cast<double>().norm());

@@ -13,23 +13,41 @@
 // at least two of the true rig's cameras (the capture's rig.json) see in
 // this frame, as stereo needs: the box also holds a closed mouth's teeth and
 // socket and the eye sockets behind the eyeballs, which no camera sees.
+// Tracked meshes, in the coarse template's topology, are scored on the
+// vertices of the coarse triangles most of whose fine triangles the region
+// keeps: a tracker is held to the face it can observe.
 
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "tega/core/mesh.h"
+#include "tega/core/rig.h"
 
 namespace tega::mvs {
 
 struct StudioTruth {
   Mesh fine;                     // world space
   std::vector<int> face_region;    // faces of `fine` that two cameras see
-  std::vector<int> face_vertices;  // the box's vertices of the coarse template, seen or not (tracked meshes)
+  std::vector<int> face_vertices;  // of the coarse template's triangles most of whose fine ones are in face_region
 };
 
-// Throws tega::Error naming the file when the capture lacks ground truth or
-// its rig.json.
+// The studio's head and true rig, read once to give the truth of any number
+// of frames. Throws tega::Error naming the file when the capture lacks
+// ground truth or its rig.json.
+class StudioTruthSource {
+ public:
+  explicit StudioTruthSource(const std::filesystem::path& capture);
+  StudioTruth frame(const std::string& take, int frame) const;
+
+ private:
+  std::filesystem::path capture_;
+  Rig rig_;
+  Mesh coarse_, fine_;    // the template and its subdivision (fine_'s positions: the template's)
+  int run_ = 0;           // fine triangles per coarse one
+  std::vector<int> box_;  // fine triangles of the face box
+};
+
 StudioTruth load_studio_truth(const std::filesystem::path& capture, const std::string& take, int frame);
 
 }  // namespace tega::mvs

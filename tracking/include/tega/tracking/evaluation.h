@@ -1,19 +1,25 @@
 #pragma once
 // Tracking scored against the virtual studio's ground truth
-// (docs/virtual-studio.md): per-vertex error over the face region, head
-// rotation error, and how the expression coefficients follow the true ones.
+// (docs/virtual-studio.md): per-vertex error over the face region (what two
+// of the true cameras see of the face in each frame), head rotation error,
+// and how the expression coefficients follow the true ones.
 // The studio's head shares the model's vertex numbering below its
 // see-through eye overlays (which it removes), where the face lies.
 
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "tega/core/geometry.h"
 #include "tega/core/mesh.h"
 #include "tega/tracking/landmark_studio_truth.h"  // studio_model_vertices, studio_landmark_sample
+
+namespace tega::mvs {
+class StudioTruthSource;
+}
 
 namespace tega::tracking {
 
@@ -60,12 +66,19 @@ struct ScoredFrame {
 class TakeTruth {
  public:
   TakeTruth(const std::filesystem::path& capture, const std::string& take);
+  ~TakeTruth();
   // `subject_neutral`: the tracked subject's neutral (head space, the model's topology), or null.
   TrackScores score(const std::vector<ScoredFrame>& frames, const Vertices* subject_neutral = nullptr) const;
 
  private:
+  // The studio's face region in a frame, its head's numbering: what two
+  // true cameras see of the face (mvs::load_studio_truth), found on first use.
+  const std::vector<int>& face_vertices(int frame) const;
+
   std::filesystem::path frames_file_;
-  std::vector<int> face_vertices_;       // the studio's face region, its head's numbering
+  std::string take_;
+  std::unique_ptr<const mvs::StudioTruthSource> studio_;
+  mutable std::map<int, std::vector<int>> face_vertices_;  // by frame
   std::vector<int> model_vertex_;        // the model's vertex of each of the studio head's
   Vertices neutral_;                     // the true subject's neutral, head space, the studio head's numbering
   std::map<int, Eigen::Matrix3d> rotation_;                         // by frame
