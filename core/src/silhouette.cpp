@@ -6,11 +6,12 @@
 
 namespace tega {
 
-Image8 mesh_silhouette(const Camera& camera, const Vertices& world, const Triangles& faces) {
+Image8 mesh_silhouette(const Camera& camera, const Vertices& world, const Triangles& faces, Facing facing) {
   Image8 mask(camera.width, camera.height, 1, 0);
   std::vector<Eigen::Vector2d> pixel(world.rows());
   std::vector<bool> in_front(world.rows());
   const bool distorted = camera.has_distortion();
+  const Eigen::Vector3d centre = camera.center();
   for (Eigen::Index i = 0; i < world.rows(); ++i) {
     const Eigen::Vector3d c = camera.world_to_camera.apply(world.row(i).transpose().cast<double>());
     in_front[i] = c.z() > 0;
@@ -22,6 +23,12 @@ Image8 mesh_silhouette(const Camera& camera, const Vertices& world, const Triang
   for (Eigen::Index f = 0; f < faces.rows(); ++f) {
     const int a = faces(f, 0), b = faces(f, 1), c = faces(f, 2);
     if (!in_front[a] || !in_front[b] || !in_front[c]) continue;
+    if (facing == Facing::toward_camera) {
+      const Eigen::Vector3d wa = world.row(a).transpose().cast<double>();
+      const Eigen::Vector3d outward = (world.row(b).transpose().cast<double>() - wa)
+                                          .cross(world.row(c).transpose().cast<double>() - wa);
+      if (outward.dot(centre - wa) <= 0) continue;
+    }
     const Eigen::Vector2d &pa = pixel[a], &pb = pixel[b], &pc = pixel[c];
     const double area = (pb - pa).x() * (pc - pa).y() - (pb - pa).y() * (pc - pa).x();
     if (area == 0) continue;

@@ -468,7 +468,10 @@ Image8 CameraMatting::matte(const Image8& photo, const Vertices& world, const Tr
                                                   const_cast<uint16_t*>(work_plate_sums_.pixels.data()))};
   // The silhouette is rasterised at the working size directly: at 26
   // megapixels the full-size raster costs more than the matte it feeds.
-  const Image8 silhouette = mesh_silhouette(work_camera_, world, faces);
+  // Only the surface facing the camera is sure subject: through the head
+  // model's open neck a camera below sees whatever is there (the body, or a
+  // backdrop), which the clean plate decides.
+  const Image8 silhouette = mesh_silhouette(work_camera_, world, faces, Facing::toward_camera);
   if (shrink_ <= 1) return matte_at_this_size(photo, plate ? &work : nullptr, silhouette, margin_px, options_);
   return shrunk_matte(photo, plate, plate ? &work : nullptr, silhouette, shrink_, margin_px, options_);
 }
