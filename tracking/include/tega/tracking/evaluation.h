@@ -72,7 +72,7 @@ class TakeTruth {
 
  private:
   // The studio's face region in a frame, its head's numbering: what two
-  // true cameras see of the face (mvs::load_studio_truth), found on first use.
+  // true cameras see of the face (mvs::StudioTruthSource), found on first use.
   const std::vector<int>& face_vertices(int frame) const;
 
   std::filesystem::path frames_file_;
