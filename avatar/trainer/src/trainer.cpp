@@ -6,6 +6,7 @@
 #include <ATen/Parallel.h>
 #include <ATen/record_function.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -120,9 +121,15 @@ class Run {
       restore_latest();
     } else {
       const at::TensorOptions floats = at::TensorOptions(at::kFloat).device(device_);
+      // The cap bounds the count at every step, so that a capped run (the
+      // paper's "Ours (200K Gaussians)") never holds more than its cap.
+      const int64_t initial = std::min(options_.initial_gaussians, options_.densify.max_gaussians);
+      if (initial < options_.initial_gaussians && options_.binding != "rigged")
+        logging::info("initial_gaussians %lld exceeds densify.max_gaussians: sampling %lld",
+                      static_cast<long long>(options_.initial_gaussians), static_cast<long long>(initial));
       model_.gaussians = options_.binding == "rigged"
                              ? initialise_rigged_gaussians(model_.lookup(), floats)
-                             : initialise_gaussians(model_.lookup(), options_.initial_gaussians, model_.metres_per_uv(),
+                             : initialise_gaussians(model_.lookup(), initial, model_.metres_per_uv(),
                                                     options_.binding == "triangle",
                                                     static_cast<uint64_t>(options_.seed), floats);
       register_parameters();

@@ -218,6 +218,19 @@ TEST(Trainer, NonFiniteStepStopsTrainingAndKeepsTheLastFiniteCheckpoint) {
     if (tensor.is_floating_point()) EXPECT_TRUE(at::isfinite(tensor).all().item<bool>()) << name;
 }
 
+// A capped run ("Ours (200K Gaussians)") never holds more than its cap, not
+// even before its first densification.
+TEST(Trainer, TheGaussianCapBoundsTheInitialSampleToo) {
+  tega::test::TempDir tmp;
+  tega::test::write_tiny_dataset(tmp / "data");
+  TrainOptions options = tiny_options();
+  options.densify.max_gaussians = 40;
+  const TrainSummary first = train(tmp / "data", tmp / "run", options, {.stop_at = 1});
+  EXPECT_EQ(first.gaussians, 40);
+  const TrainSummary last = train(tmp / "data", tmp / "run", options, {.resume = true});
+  EXPECT_LE(last.gaussians, 40);
+}
+
 TEST(Trainer, BadDatasetFailsBeforeTraining) {
   tega::test::TempDir tmp;
   tega::test::write_tiny_dataset(tmp / "data");

@@ -59,7 +59,7 @@ struct DensifyOptions {
     v("clone_max_std", clone_max_std, "Largest world std (metres) of a Gaussian that is cloned rather than split.");
     v("prune_opacity", prune_opacity, "Gaussians less opaque than this are pruned.");
     v("prune_max_std", prune_max_std, "Gaussians with a larger world std (metres) are pruned.");
-    v("max_gaussians", max_gaussians, "Upper bound on the number of Gaussians.");
+    v("max_gaussians", max_gaussians, "Upper bound on the number of Gaussians, the initial sample included.");
   }
 };
 
@@ -128,7 +128,7 @@ struct TrainOptions {
     v("iterations", iterations, "Training iterations (one view each).");
     v("device", device, "cpu or cuda.");
     v("seed", seed, "Seed of initialisation, view order and samples; a run is reproducible on the CPU.");
-    v("initial_gaussians", initial_gaussians, "Gaussians sampled uniformly over the UV area at the start.");
+    v("initial_gaussians", initial_gaussians, "Gaussians sampled uniformly over the UV area at the start (at most densify.max_gaussians).");
     v("sh_degree", sh_degree, "Highest spherical-harmonics degree (0-3).");
     v("sh_degree_interval", sh_degree_interval, "Fraction of iterations after which the active SH degree grows by one.");
     v("warmup", warmup, "Fraction of iterations trained without the deformation field and shading (canonical warm-up).");
