@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "commands.h"
+#include "stage_options.h"
 #include "tega/core/error.h"
 #include "tega/core/options.h"
 #include "tega/ingest/multiface.h"
@@ -63,11 +64,7 @@ void add_ingest_command(CLI::App& app) {
   cmd->callback([args] {
     ingest::IngestOptions options;
     if (!args->config.empty()) load_options(options, args->config, "ingest");
-    for (const auto& kv : args->overrides) {
-      const auto eq = kv.find('=');
-      if (eq == std::string::npos) throw Error("--set " + kv + ": expected key=value");
-      set_option(options, kv.substr(0, eq), kv.substr(eq + 1));
-    }
+    apply_overrides(options, args->overrides);
     if (!args->cameras.empty()) options.cameras = args->cameras;
     if (!args->test_cameras.empty()) options.test_cameras = args->test_cameras;
     if (!args->expressions.empty()) options.expressions = args->expressions;

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "commands.h"
+#include "stage_options.h"
 #include "tega/core/error.h"
 #include "tega/core/options.h"
 #include "tega/mvs/reconstruction.h"
@@ -24,11 +25,7 @@ struct MvsArguments {
 mvs::Options options_of(const MvsArguments& a) {
   mvs::Options options;
   if (!a.config.empty()) load_options(options, a.config, "mvs");
-  for (const auto& kv : a.overrides) {
-    const auto eq = kv.find('=');
-    if (eq == std::string::npos) throw Error("--set " + kv + ": expected key=value");
-    set_option(options, kv.substr(0, eq), kv.substr(eq + 1));
-  }
+  apply_overrides(options, a.overrides);
   if (!a.device.empty()) options.device = a.device;
   if (a.threads >= 0) options.threads = a.threads;
   if (a.workspace) options.write_workspace = true;

@@ -13,16 +13,22 @@
 
 namespace tega::cli {
 
+// Each --set key=value, in order.
 template <class Options>
-Options load_stage_options(const std::string& config, const std::string& section,
-                           const std::vector<std::string>& overrides) {
-  Options options;
-  if (!config.empty()) load_options(options, config, section);
+void apply_overrides(Options& options, const std::vector<std::string>& overrides) {
   for (const auto& kv : overrides) {
     const auto eq = kv.find('=');
     if (eq == std::string::npos) throw Error("--set " + kv + ": expected key=value");
     set_option(options, kv.substr(0, eq), kv.substr(eq + 1));
   }
+}
+
+template <class Options>
+Options load_stage_options(const std::string& config, const std::string& section,
+                           const std::vector<std::string>& overrides) {
+  Options options;
+  if (!config.empty()) load_options(options, config, section);
+  apply_overrides(options, overrides);
   return options;
 }
 

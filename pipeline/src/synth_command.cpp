@@ -1,10 +1,13 @@
-// `tega synth`: the virtual studio. Parses flags over an optional YAML
-// config and calls tega::synth::render_virtual_studio().
+// `tega synth`: the virtual studio. Parses flags and --set over an optional
+// YAML config and calls tega::synth::render_virtual_studio().
 
 #include <iostream>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "commands.h"
+#include "stage_options.h"
 #include "tega/core/error.h"
 #include "tega/core/options.h"
 #include "tega/core/progress.h"
@@ -15,6 +18,7 @@ namespace {
 
 struct SynthArgs {
   std::string out, config, head;
+  std::vector<std::string> overrides;
   int cameras = 0, frames = 0, width = 0, height = 0, threads = 0;
   int64_t seed = 0;
   bool print_options = false, force = false, truth_apart = false;
@@ -24,6 +28,7 @@ struct SynthArgs {
 synth::Options resolve_options(const SynthArgs& a) {
   synth::Options o;
   if (!a.config.empty()) load_options(o, a.config);
+  apply_overrides(o, a.overrides);
   if (a.cameras_opt->count()) o.studio.cameras = a.cameras;
   if (a.width_opt->count()) o.studio.width = a.width;
   if (a.height_opt->count()) o.studio.height = a.height;
@@ -72,6 +77,8 @@ void add_synth_command(CLI::App& app) {
                                    "Blendshape model directory laid out like ICT-FaceKit (default: the built-in head).");
   args->threads_opt = cmd->add_option("--threads", args->threads, "Worker threads (default: one per hardware thread).");
   cmd->add_option("--config", args->config, "YAML file of synth options (see --print-options); flags override it.");
+  cmd->add_option("--set", args->overrides,
+                  "Override one option over --config, e.g. --set tracking_error.lag=0 (repeatable).");
   cmd->add_flag("--print-options", args->print_options, "Print the resolved options as documented YAML and exit.");
   cmd->add_flag("--force", args->force, "Replace an existing output directory.");
   cmd->add_flag("--truth-apart", args->truth_apart,

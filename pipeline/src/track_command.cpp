@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "commands.h"
+#include "stage_options.h"
 #include "tega/core/error.h"
 #include "tega/core/options.h"
 #include "tega/tracking/evaluation.h"
@@ -25,11 +26,7 @@ struct TrackArguments {
 tracking::Options options_of(const TrackArguments& a) {
   tracking::Options options;
   if (!a.config.empty()) load_options(options, a.config, "track");
-  for (const auto& kv : a.overrides) {
-    const auto eq = kv.find('=');
-    if (eq == std::string::npos) throw Error("--set " + kv + ": expected key=value");
-    set_option(options, kv.substr(0, eq), kv.substr(eq + 1));
-  }
+  apply_overrides(options, a.overrides);
   if (!a.model.empty()) options.model = a.model;
   if (!a.identity.empty()) options.identity = a.identity;
   if (!a.landmarks.empty()) options.landmarks.model = a.landmarks;

@@ -3,6 +3,7 @@
 #include <optional>
 
 #include "commands.h"
+#include "stage_options.h"
 #include "tega/core/error.h"
 #include "tega/core/options.h"
 #include "tega/trainer/trainer.h"
@@ -52,11 +53,7 @@ void add_train_command(CLI::App& app) {
     }
     if (!args->baseline.empty()) trainer::apply_baseline(options, args->baseline);
     for (const auto& ablation : args->ablations) trainer::apply_ablation(options, ablation);
-    for (const auto& kv : args->overrides) {
-      const auto eq = kv.find('=');
-      if (eq == std::string::npos) throw Error("--set " + kv + ": expected key=value");
-      set_option(options, kv.substr(0, eq), kv.substr(eq + 1));
-    }
+    apply_overrides(options, args->overrides);
     if (args->iterations) options.iterations = *args->iterations;
     if (args->device) options.device = *args->device;
     if (args->profile) options.profile = true;

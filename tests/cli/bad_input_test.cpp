@@ -61,6 +61,26 @@ TEST(CliBadInput, TrackNamesAMissingCaptureAndAMissingModel) {
   EXPECT_NE(options.output.find("landmarks:"), std::string::npos) << options.output;
 }
 
+// `tega synth --set` over a config: how a study varies one option of its
+// capture (scripts/ablation-study's SYNTH_SET).
+TEST(CliSynth, SetOverridesTheConfigAndAnUnknownKeyIsNamed) {
+  tega::test::TempDir tmp;
+  tega::test::write_text(tmp / "capture.yaml", "frames: 4\ntracking_error: {offset_m: 0.002, lag: 0.5}\n");
+  const auto r = run_tega("synth --config " + (tmp / "capture.yaml").string() +
+                          " --set tracking_error.lag=0 --set tracking_error.eyelid_gain=0.75 --print-options");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("\nframes: 4\n"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("  offset_m: 0.002\n"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("  lag: 0\n"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("  eyelid_gain: 0.75\n"), std::string::npos) << r.output;
+  const auto unknown = run_tega("synth --set tracking_error.lagg=0 --print-options");
+  EXPECT_EQ(unknown.exit_code, 1) << unknown.output;
+  EXPECT_NE(unknown.output.find("'tracking_error.lagg'"), std::string::npos) << unknown.output;
+  const auto malformed = run_tega("synth --set frames --print-options");
+  EXPECT_EQ(malformed.exit_code, 1) << malformed.output;
+  EXPECT_NE(malformed.output.find("--set frames: expected key=value"), std::string::npos) << malformed.output;
+}
+
 TEST(CliRigConvert, KrtToJsonToColmapInMetres) {
   tega::test::TempDir tmp;
   tega::test::write_text(tmp / "KRT",
