@@ -28,6 +28,9 @@ void add_inspect_command(CLI::App& app) {
   cmd->add_option("--json", args->json, "Output JSON file (one entry per model); the Markdown goes beside it (.md).");
   cmd->add_option("--gradient-views", args->options.gradient_views,
                   "Training views the gradients are averaged over (default 8).");
+  cmd->add_option("--truth", args->options.truth,
+                  "A tega synth capture (with truth_apart, its CAPTURE.truth/): how far the dataset's meshes put the "
+                  "Gaussians from where its true meshes would, and how much of that the deformation field undoes.");
   cmd->add_option("--device", args->device, "cpu or cuda (default: each run's device).");
   cmd->callback([args] {
     nlohmann::json all = nlohmann::json::array();

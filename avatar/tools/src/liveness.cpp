@@ -6,6 +6,12 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <set>
+#include <utility>
+
+#include "tega/core/error.h"
+#include "tega/core/files.h"
+#include "tega/core/mesh.h"
 
 #include "image_tensors.h"
 #include "tega/nn/losses.h"
@@ -41,6 +47,68 @@ double expression_mm(const Vertices& world, const RigidTransform& head_to_world,
   }
   return 1000.0 * sum / std::max<int64_t>(1, world.rows());
 }
+
+// The true coarse mesh and head pose of a dataset frame of a virtual-studio
+// capture: ground_truth/<take>/frames.json and the coarse meshes it names
+// (docs/virtual-studio.md#takes), for dataset frames named <take>_<frame>.
+class StudioTruth {
+ public:
+  explicit StudioTruth(const std::filesystem::path& capture) : root_(capture / "ground_truth") {
+    if (!std::filesystem::is_directory(root_))
+      throw Error(capture, "no ground_truth/ folder: --truth takes a tega synth capture (with truth_apart, its "
+                           "CAPTURE.truth/)");
+  }
+
+  std::pair<Vertices, RigidTransform> frame(const DatasetFrame& f, int vertices) {
+    const std::filesystem::path file = root_ / f.sequence / "frames.json";
+    const std::string prefix = f.sequence + "_";
+    const std::string number = f.id.substr(std::min(prefix.size(), f.id.size()));
+    if (f.sequence.empty() || f.id.rfind(prefix, 0) != 0 || number.size() != 6 ||
+        number.find_first_not_of("0123456789") != std::string::npos)
+      throw Error(root_, "dataset frame '" + f.id + "' is not <take>_<6-digit frame> of a virtual-studio take");
+    const nlohmann::json& take = take_of(file);
+    const int index = std::stoi(number);
+    for (const auto& entry : take.value("frames", nlohmann::json::array())) {
+      if (entry.value("index", -1) != index) continue;
+      Eigen::Matrix<double, 3, 4> pose;
+      try {
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 4; ++c) pose(r, c) = entry.at("head_to_world").at(r).at(c).get<double>();
+      } catch (const nlohmann::json::exception&) {
+        throw Error(file, "frame " + number + ": head_to_world must be 3 rows of 4 numbers");
+      }
+      std::string coarse = take.value("coarse", "");
+      const std::string slot = "{frame:06d}";
+      if (coarse.find(slot) == std::string::npos) throw Error(file, "no coarse mesh pattern with " + slot);
+      coarse.replace(coarse.find(slot), slot.size(), number);
+      return {read_vertices_bin(file.parent_path() / coarse, vertices), RigidTransform::from_matrix(pose)};
+    }
+    throw Error(file, "no frame " + number + " (dataset frame '" + f.id + "')");
+  }
+
+ private:
+  const nlohmann::json& take_of(const std::filesystem::path& file) {
+    auto found = takes_.find(file);
+    if (found != takes_.end()) return found->second;
+    try {
+      return takes_[file] = nlohmann::json::parse(read_text_file(file));
+    } catch (const nlohmann::json::exception& e) {
+      throw Error(file, std::string("not valid JSON: ") + e.what());
+    }
+  }
+
+  std::filesystem::path root_;
+  std::map<std::filesystem::path, nlohmann::json> takes_;
+};
+
+// Sums of per-frame mean squared distances (m²) of one split's frames.
+struct SquaredErrors {
+  double mesh = 0, corrected = 0;
+  std::optional<double> undone() const {
+    if (mesh <= 0) return std::nullopt;
+    return 1.0 - std::sqrt(corrected / mesh);
+  }
+};
 
 // The network part a parameter belongs to, by its registered path.
 std::string network_part(const std::string& name) {
@@ -121,15 +189,35 @@ Liveness inspect_avatar(trainer::TrainedAvatar& avatar, const Dataset& dataset, 
 
   std::vector<double> expression, deformation, shading_change;
   at::Tensor shading_sum, shading_square_sum;
+  std::optional<StudioTruth> truth;
+  if (!options.truth.empty()) truth.emplace(options.truth);
+  const std::set<std::string> held_out(dataset.test.frames.begin(), dataset.test.frames.end());
+  SquaredErrors train_errors, test_errors;
   {
     at::NoGradGuard no_grad;
     for (const DatasetFrame& f : dataset.frames) {
       const Vertices vertices = dataset.load_mesh(f.id);
       const trainer::FrameInput input = model.frame_input(vertices, f.head_to_world);
-      FrameLiveness frame{f.id, expression_mm(vertices, f.head_to_world, dataset.template_mesh)};
+      FrameLiveness frame;
+      frame.frame = f.id;
+      frame.expression_mm = expression_mm(vertices, f.head_to_world, dataset.template_mesh);
+      const at::Tensor placed = model.pose(input, without_field).means;
+      const at::Tensor deformed = out.deformation ? model.pose(input, avatar.phase).means : placed;
+      if (truth) {
+        const auto [true_vertices, true_pose] = truth->frame(f, dataset.template_mesh.num_vertices());
+        const at::Tensor target = model.pose(model.frame_input(true_vertices, true_pose), without_field).means;
+        const double mesh = (placed - target).pow(2).sum(1).mean().item<double>();
+        SquaredErrors& split = held_out.count(f.id) ? test_errors : train_errors;
+        split.mesh += mesh;
+        frame.mesh_error_mm = 1000.0 * std::sqrt(mesh);
+        if (out.deformation) {
+          const double corrected = (deformed - target).pow(2).sum(1).mean().item<double>();
+          split.corrected += corrected;
+          frame.corrected_error_mm = 1000.0 * std::sqrt(corrected);
+        }
+      }
       if (out.deformation) {
-        const at::Tensor moved =
-            (model.pose(input, avatar.phase).means - model.pose(input, without_field).means).norm(2, 1) * 1000.0;
+        const at::Tensor moved = (deformed - placed).norm(2, 1) * 1000.0;
         const at::Tensor moving = moved.index({moved > 1e-6});  // eyeballs stay put
         frame.deformation_mean_mm = moving.numel() ? moving.mean().item<double>() : 0.0;
         frame.deformation_p95_mm = quantile_of(moving, 0.95);
@@ -148,6 +236,10 @@ Liveness inspect_avatar(trainer::TrainedAvatar& avatar, const Dataset& dataset, 
       out.frames.push_back(frame);
     }
     out.deformation_expression_r = out.deformation ? pearson(expression, deformation) : std::nan("");
+    if (truth && out.deformation) {
+      out.error_undone_train = train_errors.undone();
+      out.error_undone_test = test_errors.undone();
+    }
     out.shading_expression_r = out.shading ? pearson(expression, shading_change) : std::nan("");
     if (shading_sum.defined()) {
       const double n = double(dataset.frames.size());
@@ -166,6 +258,15 @@ Liveness inspect_avatar(trainer::TrainedAvatar& avatar, const Dataset& dataset, 
 namespace {
 
 nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+nlohmann::json optional_number(const std::optional<double>& v) { return v ? number(*v) : nlohmann::json(nullptr); }
+
+// Root mean square over frames of a per-frame RMS figure.
+double rms_over_frames(const Liveness& l, std::optional<double> FrameLiveness::*figure) {
+  double sum = 0;
+  for (const auto& f : l.frames) sum += std::pow((f.*figure).value_or(0.0), 2) / double(l.frames.size());
+  return std::sqrt(sum);
+}
 
 std::string fixed(double v, int digits) {
   if (!std::isfinite(v)) return "n/a";
@@ -191,7 +292,9 @@ nlohmann::json liveness_json(const Liveness& l) {
                       {"deformation_p95_mm", f.deformation_p95_mm},
                       {"shading_p01", f.shading_p01},
                       {"shading_p50", f.shading_p50},
-                      {"shading_p99", f.shading_p99}});
+                      {"shading_p99", f.shading_p99},
+                      {"mesh_error_mm", optional_number(f.mesh_error_mm)},
+                      {"corrected_error_mm", optional_number(f.corrected_error_mm)}});
   nlohmann::json gradients = nlohmann::json::object();
   for (const auto& g : l.gradients) gradients[g.part] = g.mean_norm;
   return {{"format", "tega-inspect"},
@@ -203,7 +306,9 @@ nlohmann::json liveness_json(const Liveness& l) {
           {"deformation_expression_r", number(l.deformation_expression_r)},
           {"shading_frame_std", l.shading ? number(l.shading_frame_std) : nlohmann::json(nullptr)},
           {"shading_expression_r", number(l.shading_expression_r)},
-          {"off_birth_triangle", l.off_birth_triangle ? number(*l.off_birth_triangle) : nlohmann::json(nullptr)},
+          {"off_birth_triangle", optional_number(l.off_birth_triangle)},
+          {"error_undone_train", optional_number(l.error_undone_train)},
+          {"error_undone_test", optional_number(l.error_undone_test)},
           {"gradient_norms", gradients},
           {"frames", frames}};
 }
@@ -229,6 +334,15 @@ std::string liveness_markdown(const Liveness& l, const std::string& name) {
   out += l.off_birth_triangle ? "- Gaussians off the triangle they were created on: " +
                                     fixed(100.0 * *l.off_birth_triangle, 2) + " %\n"
                               : "- triangle changes: not tracked (bound Gaussians, or a checkpoint without birth triangles)\n";
+  if (!l.frames.empty() && l.frames.front().mesh_error_mm) {
+    out += "- against the true meshes: the dataset's meshes put the Gaussians " +
+           fixed(rms_over_frames(l, &FrameLiveness::mesh_error_mm), 3) + " mm (RMS) from where the true meshes would";
+    out += l.error_undone_train || l.error_undone_test
+               ? "; with the field " + fixed(rms_over_frames(l, &FrameLiveness::corrected_error_mm), 3) + " mm: " +
+                     fixed(100.0 * l.error_undone_train.value_or(std::nan("")), 1) + " % of it undone on training frames, " +
+                     fixed(100.0 * l.error_undone_test.value_or(std::nan("")), 1) + " % on held-out frames\n"
+               : "\n";
+  }
   out += "- mean gradient norm of L1 + D-SSIM per part:";
   for (const auto& g : l.gradients) out += " " + g.part + " " + scientific(g.mean_norm) + ";";
   out += "\n";

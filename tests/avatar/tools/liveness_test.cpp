@@ -1,18 +1,50 @@
 // tega inspect's liveness figures on the tiny avatar: a perturbed network
 // moves and shades Gaussians and every part gets a gradient; a field whose
 // output layer is zero moves nothing; parts switched off are reported off;
-// Gaussians off their birth triangle are counted.
+// Gaussians off their birth triangle are counted; against a virtual-studio
+// ground truth, the share of the meshes' error the field undoes.
 
 #include "tega/tools/liveness.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
+
+#include "tega/core/error.h"
+#include "tega/core/mesh.h"
 
 #include "tiny_avatar.h"
 
 namespace tega::tools {
 namespace {
+
+// A ground_truth/ folder (as tega synth writes it) for the tiny dataset whose
+// true meshes are the dataset's, shifted by shifts[frame] metres.
+void write_shifted_truth(const std::filesystem::path& capture, const Dataset& d,
+                         const std::map<std::string, Eigen::RowVector3f>& shifts) {
+  for (const DatasetFrame& f : d.frames) {
+    const std::filesystem::path take = capture / "ground_truth" / f.sequence;
+    std::filesystem::create_directories(take / "coarse");
+    test::write_text(take / "frames.json",
+                     R"({"coarse": "coarse/{frame:06d}.bin", "frames": [{"index": 0, "head_to_world": )"
+                     R"([[1, 0, 0, 0.01], [0, 1, 0, 0], [0, 0, 1, 0]]}]})");
+    Vertices truth = d.load_mesh(f.id);
+    truth.rowwise() += shifts.at(f.id);
+    write_vertices_bin(truth, take / "coarse/000000.bin");
+  }
+}
+
+// The field set to one constant offset (head space, the tiny frames' head
+// rotation being the identity): every Gaussian moves by `offset`.
+void set_constant_field(trainer::AvatarModel& model, const Eigen::Vector3f& offset) {
+  at::NoGradGuard no_grad;
+  for (auto& item : model.network->named_parameters(true)) {
+    if (item.key() == "deformation.output.weight") item.value().zero_();
+    if (item.key() == "deformation.output.bias")
+      item.value().copy_(at::tensor({offset.x(), offset.y(), offset.z()}, at::kFloat));
+  }
+}
 
 double gradient_of(const Liveness& l, const std::string& part) {
   for (const auto& g : l.gradients)
@@ -79,6 +111,52 @@ TEST(Liveness, CountsGaussiansOffTheirBirthTriangle) {
   const Liveness l = inspect_avatar(*tiny.avatar, tiny.dataset, {});
   ASSERT_TRUE(l.off_birth_triangle.has_value());
   EXPECT_NEAR(*l.off_birth_triangle, 1.0 / 3.0, 1e-12);
+}
+
+// The field moves every Gaussian by 2 mm along x. Where the true mesh lies
+// 2 mm along x of the dataset's (the training frame), it undoes the whole
+// error; where it lies 4 mm along x (the held-out frame), half of it.
+TEST(Liveness, AgainstTheTruthTheShareOfTheMeshErrorTheFieldUndoes) {
+  test::TinyAvatar tiny;
+  set_constant_field(tiny.model(), {0.002f, 0, 0});
+  write_shifted_truth(tiny.tmp / "capture", tiny.dataset,
+                      {{"smile_000000", {0.002f, 0, 0}}, {"blink_000000", {0.004f, 0, 0}}});
+  LivenessOptions options;
+  options.truth = tiny.tmp / "capture";
+  const Liveness l = inspect_avatar(*tiny.avatar, tiny.dataset, options);
+  ASSERT_EQ(l.frames.size(), 2u);
+  EXPECT_NEAR(*l.frames[0].mesh_error_mm, 2.0, 1e-3);
+  EXPECT_NEAR(*l.frames[0].corrected_error_mm, 0.0, 1e-3);
+  EXPECT_NEAR(*l.frames[1].mesh_error_mm, 4.0, 1e-3);
+  EXPECT_NEAR(*l.frames[1].corrected_error_mm, 2.0, 1e-3);
+  ASSERT_TRUE(l.error_undone_train && l.error_undone_test);
+  EXPECT_NEAR(*l.error_undone_train, 1.0, 1e-3);
+  EXPECT_NEAR(*l.error_undone_test, 0.5, 1e-3);
+  EXPECT_NEAR(liveness_json(l).at("error_undone_test").get<double>(), 0.5, 1e-3);
+  const std::string text = liveness_markdown(l, "truth");
+  EXPECT_NE(text.find("100.0 % of it undone on training frames, 50.0 % on held-out frames"), std::string::npos)
+      << text;
+
+  // A field pushing the wrong way adds error; with the field off nothing is undone or added.
+  set_constant_field(tiny.model(), {-0.002f, 0, 0});
+  EXPECT_NEAR(*inspect_avatar(*tiny.avatar, tiny.dataset, options).error_undone_train, -1.0, 1e-3);
+  tiny.avatar->phase.deformation = false;
+  const Liveness off = inspect_avatar(*tiny.avatar, tiny.dataset, options);
+  EXPECT_NEAR(*off.frames[1].mesh_error_mm, 4.0, 1e-3);
+  EXPECT_FALSE(off.frames[1].corrected_error_mm.has_value());
+  EXPECT_FALSE(off.error_undone_train.has_value());
+}
+
+TEST(Liveness, ATruthThatIsNoVirtualStudioCaptureIsNamed) {
+  test::TinyAvatar tiny;
+  LivenessOptions options;
+  options.truth = tiny.tmp / "nowhere";
+  try {
+    inspect_avatar(*tiny.avatar, tiny.dataset, options);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("nowhere: no ground_truth/ folder"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

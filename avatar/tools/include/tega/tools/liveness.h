@@ -12,6 +12,10 @@
 //                             frames, and r of mean |S - 1| against the expression
 //   free UVD binding (§3.3)   the fraction of Gaussians no longer on the
 //                             triangle they were created on
+//   the mesh's error (§3.4)   with a virtual-studio capture's ground truth:
+//                             how far the dataset's meshes put each Gaussian
+//                             from where the true meshes would, and how much
+//                             of that the deformation field undoes
 //   gradients                 the mean L2 norm of the photometric loss's
 //                             gradient (L1 + D-SSIM, the run's weights) that
 //                             each part receives, over training views
@@ -20,6 +24,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -31,6 +36,10 @@ namespace tega::tools {
 
 struct LivenessOptions {
   int gradient_views = 8;  // training views (spread over frames and cameras) for the gradients
+  // A `tega synth` capture (with truth_apart, its CAPTURE.truth/) whose
+  // ground_truth/ holds the true meshes of the dataset's frames; empty: the
+  // mesh's error is not scored.
+  std::filesystem::path truth;
 };
 
 struct FrameLiveness {
@@ -39,6 +48,10 @@ struct FrameLiveness {
   double deformation_mean_mm = 0;  // |Δμ| over the Gaussians the field moves
   double deformation_p95_mm = 0;
   double shading_p01 = 1, shading_p50 = 1, shading_p99 = 1;
+  // With a truth: RMS over the Gaussians of their distance from where the
+  // frame's true mesh puts them, placed by the dataset's mesh alone and with
+  // the deformation field (absent where the field is off).
+  std::optional<double> mesh_error_mm, corrected_error_mm;
 };
 
 struct PartGradient {
@@ -55,6 +68,10 @@ struct Liveness {
   double shading_frame_std = 0;           // mean over Gaussians of S's std over frames
   double shading_expression_r = 0;
   std::optional<double> off_birth_triangle;  // fraction; absent when the run does not track it
+  // With a truth and the field on: 1 - corrected / mesh error (RMS over the
+  // split's frames and Gaussians) on training and held-out frames, the share
+  // of the meshes' error the field undoes (1 all, 0 none, < 0 it adds error).
+  std::optional<double> error_undone_train, error_undone_test;
   std::vector<PartGradient> gradients;
 };
 
