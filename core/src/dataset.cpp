@@ -142,7 +142,7 @@ Vertices Dataset::load_mesh(const std::string& frame_id) const {
 static Dataset read_dataset_fields(const fs::path& root) {
   const fs::path file = root / kManifest;
   if (!fs::exists(file)) throw Error(root, "is not a tega dataset (no dataset.json)");
-  const json manifest = detail::read_json_file(file);
+  const json manifest = read_json_file(file);
   if (manifest.value("format", "") != kFormat) throw Error(file, "is not a tega dataset manifest (format)");
   const int version = manifest.contains("version") ? detail::json_as<int>(manifest.at("version"), "version", file) : 0;
   if (version != kVersion) {

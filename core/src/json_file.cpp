@@ -1,9 +1,9 @@
-#include "json_file.h"
+#include "tega/core/json_file.h"
 
 #include "tega/core/error.h"
 #include "tega/core/files.h"
 
-namespace tega::detail {
+namespace tega {
 
 nlohmann::json read_json_file(const std::filesystem::path& file) {
   try {
@@ -13,4 +13,4 @@ nlohmann::json read_json_file(const std::filesystem::path& file) {
   }
 }
 
-}  // namespace tega::detail
+}  // namespace tega

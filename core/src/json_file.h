@@ -10,11 +10,9 @@
 #include <utility>
 
 #include "tega/core/error.h"
+#include "tega/core/json_file.h"
 
 namespace tega::detail {
-
-// Throws tega::Error naming the file when it is missing or not valid JSON.
-nlohmann::json read_json_file(const std::filesystem::path& file);
 
 // Whether `value` is an integer that T holds. nlohmann converts any number to
 // any arithmetic type unchecked (a fraction or a huge number into an int is

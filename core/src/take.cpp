@@ -77,7 +77,7 @@ bool TakeInfo::has_image(const std::string& camera, int frame) const {
 
 TakeInfo read_take(const fs::path& take_folder) {
   const fs::path file = take_folder / kTakeFile;
-  const json j = detail::read_json_file(file);
+  const json j = read_json_file(file);
   TakeInfo t;
   t.name = field<std::string>(j, "name", file);
   t.kind = field<std::string>(j, "kind", file);
@@ -189,7 +189,7 @@ std::vector<std::string> CaptureInfo::performance_takes(const std::vector<std::s
 CaptureInfo read_capture(const fs::path& capture_root) {
   const fs::path file = capture_root / kCaptureFile;
   if (!fs::exists(file)) throw Error(capture_root, "is not a tega capture (no capture.json)");
-  const json j = detail::read_json_file(file);
+  const json j = read_json_file(file);
   check_capture_format(j, file);
   CaptureInfo c;
   c.root = capture_root;
@@ -239,7 +239,7 @@ void record_take_in_capture(const fs::path& capture_root, const TakeInfo& take, 
   const fs::path file = capture_root / kCaptureFile;
   json capture;
   if (fs::exists(file)) {
-    capture = detail::read_json_file(file);
+    capture = read_json_file(file);
     check_capture_format(capture, file);
   } else {
     capture = {{"format", kCaptureFormat}, {"version", kCaptureVersion}, {"generator", generator},

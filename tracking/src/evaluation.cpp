@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tega/core/error.h"
-#include "tega/core/files.h"
+#include "tega/core/json_file.h"
 #include "tega/core/mesh.h"
 #include "tega/mvs/studio_truth.h"
 #include "tega/tracking/tracked.h"
@@ -16,14 +16,6 @@ namespace tega::tracking {
 namespace fs = std::filesystem;
 
 namespace {
-
-nlohmann::json read_json(const fs::path& file) {
-  try {
-    return nlohmann::json::parse(read_text_file(file));
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(file, std::string("is not valid JSON: ") + e.what());
-  }
-}
 
 Eigen::Matrix3d rotation_of(const nlohmann::json& rows) {
   Eigen::Matrix3d R;
@@ -61,7 +53,7 @@ TakeTruth::TakeTruth(const fs::path& capture, const std::string& take)
       model_vertex_(studio_model_vertices(capture)) {
   neutral_ = read_obj(capture / "ground_truth" / "head" / "template.obj").positions;
   const int coarse_vertices = int(neutral_.rows());
-  const nlohmann::json frames = read_json(frames_file_);
+  const nlohmann::json frames = read_json_file(frames_file_);
   for (const auto& f : frames.at("frames")) {
     const int frame = f.at("index").get<int>();
     rotation_[frame] = rotation_of(f.at("head_to_world"));

@@ -10,7 +10,7 @@
 #include <utility>
 
 #include "tega/core/error.h"
-#include "tega/core/files.h"
+#include "tega/core/json_file.h"
 #include "tega/core/mesh.h"
 
 #include "image_tensors.h"
@@ -89,12 +89,7 @@ class StudioTruth {
  private:
   const nlohmann::json& take_of(const std::filesystem::path& file) {
     auto found = takes_.find(file);
-    if (found != takes_.end()) return found->second;
-    try {
-      return takes_[file] = nlohmann::json::parse(read_text_file(file));
-    } catch (const nlohmann::json::exception& e) {
-      throw Error(file, std::string("not valid JSON: ") + e.what());
-    }
+    return found != takes_.end() ? found->second : takes_[file] = read_json_file(file);
   }
 
   std::filesystem::path root_;

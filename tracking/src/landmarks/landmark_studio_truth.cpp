@@ -8,21 +8,13 @@
 #include <nlohmann/json.hpp>
 
 #include "tega/core/error.h"
-#include "tega/core/files.h"
+#include "tega/core/json_file.h"
 #include "tega/core/image.h"
 
 namespace tega::tracking {
 namespace fs = std::filesystem;
 
 namespace {
-
-nlohmann::json read_json(const fs::path& file) {
-  try {
-    return nlohmann::json::parse(read_text_file(file));
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(file, std::string("is not valid JSON: ") + e.what());
-  }
-}
 
 fs::path head_json(const fs::path& truth) { return truth / "ground_truth" / "head" / "head.json"; }
 
@@ -34,7 +26,7 @@ std::string frame_name(int frame) {
 
 // frame -> the rotation of its head_to_world (a take's frames.json).
 std::map<int, Eigen::Matrix3d> head_rotations(const fs::path& frames_file) {
-  const nlohmann::json frames = read_json(frames_file);
+  const nlohmann::json frames = read_json_file(frames_file);
   std::map<int, Eigen::Matrix3d> rotations;
   try {
     for (const auto& frame : frames.at("frames")) {
@@ -64,7 +56,7 @@ fs::path studio_truth_root(const fs::path& capture) {
 std::vector<int> studio_model_vertices(const fs::path& capture) {
   const int studio_vertices = read_obj(capture / "ground_truth" / "head" / "template.obj").num_vertices();
   const fs::path file = head_json(capture);
-  const auto head = read_json(file);
+  const auto head = read_json_file(file);
   std::vector<int> model_vertex;
   for (const auto& run : head.value("source_vertex_runs", nlohmann::json::array()))
     for (int v = run.at(0).get<int>(); v <= run.at(1).get<int>(); ++v) model_vertex.push_back(v);
@@ -78,7 +70,7 @@ std::vector<int> studio_model_vertices(const fs::path& capture) {
 
 fs::path studio_head_model(const fs::path& capture) {
   const fs::path file = head_json(studio_truth_root(capture));
-  const std::string source = read_json(file).value("source", "");
+  const std::string source = read_json_file(file).value("source", "");
   if (source.empty() || source == "procedural")
     throw Error(file, "the studio rendered its procedural head, which has no landmark vertices: render a model "
                       "laid out like ICT-FaceKit (tega synth --head DIR)");
@@ -90,7 +82,7 @@ fs::path studio_head_model(const fs::path& capture) {
 std::vector<int> model_landmark_vertices(const fs::path& model_directory) {
   const fs::path file = model_directory / "vertex_indices.json";
   if (!fs::exists(file)) throw Error(file, "not found: the model's landmark vertices (idx_to_landmark_verts)");
-  const nlohmann::json indices = read_json(file);
+  const nlohmann::json indices = read_json_file(file);
   if (!indices.contains("idx_to_landmark_verts")) throw Error(file, "has no idx_to_landmark_verts");
   const auto vertices = indices.at("idx_to_landmark_verts").get<std::vector<int>>();
   if (vertices.size() != kLandmarkCount)
