@@ -13,6 +13,7 @@
 #include <ctime>
 #include <filesystem>
 
+#include "tega/core/downsample.h"
 #include "tega/core/files.h"
 #include "tega/core/image.h"
 #include "tega/core/mesh.h"
@@ -100,7 +101,7 @@ void stage_table(const fs::path& capture, const Camera& camera, int downsample) 
     rgb = matting::read_recorded_rgb(take, camera.name, 0, camera.width, camera.height, downsample);
   });
   const double matte_s = timed(1, [&] {
-    matte = matting::area_downsampled(
+    matte = box_downsample(
         read_image_u8(capture / "ground_truth" / "expressions" / "alpha" / camera.name / "000000.png"), downsample);
   });
   const matting::DatasetResampler resampler(camera, downsample);

@@ -13,6 +13,13 @@ Image8 box_downsample(const Image8& image, int factor) {
     throw Error("downsample " + std::to_string(factor) + " does not divide the image size " +
                 std::to_string(image.width) + "x" + std::to_string(image.height));
   }
+  return box_downsample_dropping_remainder(image, factor);
+}
+
+Image8 box_downsample_dropping_remainder(const Image8& image, int factor) {
+  if (factor < 1 || factor > image.width || factor > image.height)
+    throw Error("downsample " + std::to_string(factor) + " does not fit the image size " +
+                std::to_string(image.width) + "x" + std::to_string(image.height));
   if (factor == 1) return image;
   Image8 out(image.width / factor, image.height / factor, image.channels);
   const int area = factor * factor;

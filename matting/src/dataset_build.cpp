@@ -6,6 +6,7 @@
 
 #include "clean_plate.h"
 #include "opencv_threads.h"
+#include "tega/core/downsample.h"
 #include "tega/core/dataset.h"
 #include "tega/core/dataset_gaps.h"
 #include "tega/core/error.h"
@@ -311,9 +312,9 @@ DatasetBuildSummary build_dataset(const DatasetBuildRequest& request, const Data
       }
       const Image8 matte =
           matting ? matting->matte(rgb, read_vertices_bin(f.tracked.mesh, vertices), dataset.template_mesh.faces)
-                  : area_downsampled(read_matte(matte_path(request.mattes, f, camera), captured.width,
-                                                captured.height, view_name(f, camera)),
-                                     downsample);
+                  : box_downsample(read_matte(matte_path(request.mattes, f, camera), captured.width, captured.height,
+                                              view_name(f, camera)),
+                                   downsample);
       const Image8 rgba = resampler.rgba(rgb, matte);
       const PixelView view{rgba.pixels.data(), rgba.width, rgba.height, 4, 8, static_cast<size_t>(rgba.width) * 4};
       if (options.image_format == "zst") write_zstd_view(view, dataset.image_path(camera, f.id()), 1);

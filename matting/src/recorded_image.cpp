@@ -1,21 +1,11 @@
 #include "tega/matting/recorded_image.h"
 
-#include <opencv2/imgproc.hpp>
-
+#include "tega/core/downsample.h"
 #include "tega/core/error.h"
 #include "tega/mvs/debayer.h"
 #include "tega/mvs/frame_views.h"
 
 namespace tega::matting {
-
-Image8 area_downsampled(const Image8& image, int factor) {
-  if (factor == 1) return image;
-  Image8 out(image.width / factor, image.height / factor, image.channels);
-  const cv::Mat in(image.height, image.width, CV_8UC(image.channels), const_cast<uint8_t*>(image.pixels.data()));
-  cv::Mat target(out.height, out.width, CV_8UC(out.channels), out.pixels.data());
-  cv::resize(in, target, target.size(), 0, 0, cv::INTER_AREA);
-  return out;
-}
 
 Image8 read_recorded_rgb(const TakeInfo& take, const std::string& camera, int frame, int width, int height,
                          int downsample) {
@@ -26,8 +16,8 @@ Image8 read_recorded_rgb(const TakeInfo& take, const std::string& camera, int fr
                           camera + " of the rig is " + std::to_string(width) + "x" + std::to_string(height));
   const bool raw_bayer = take.pixel_format.rfind("Bayer", 0) == 0 && recorded.channels == 1;
   if (raw_bayer && downsample % 2 == 0)
-    return area_downsampled(mvs::debayer_half(recorded, take.pixel_format), downsample / 2);
-  return area_downsampled(mvs::recorded_rgb(recorded, take, mvs::debayer, file.string()), downsample);
+    return box_downsample_dropping_remainder(mvs::debayer_half(recorded, take.pixel_format), downsample / 2);
+  return box_downsample_dropping_remainder(mvs::recorded_rgb(recorded, take, mvs::debayer, file.string()), downsample);
 }
 
 }  // namespace tega::matting

@@ -1,26 +1,12 @@
 #include "tega/tracking/photos.h"
 
 #include <algorithm>
-#include <opencv2/imgproc.hpp>
 
+#include "tega/core/downsample.h"
 #include "tega/mvs/debayer.h"
 #include "tega/mvs/frame_views.h"
 
 namespace tega::tracking {
-namespace {
-
-Image8 area_downsampled(const Image8& image, int factor) {
-  if (factor == 1) return image;
-  Image8 out(image.width / factor, image.height / factor, image.channels);
-  const cv::Mat in(image.height, image.width, CV_8UC(image.channels), const_cast<uint8_t*>(image.pixels.data()));
-  cv::Mat target(out.height, out.width, CV_8UC(out.channels), out.pixels.data());
-  // A factor-by-factor block average: the top-left out.width * factor columns
-  // and rows, so that pixel x of the result is the block around factor * (x + 0.5) - 0.5.
-  cv::resize(in(cv::Rect(0, 0, out.width * factor, out.height * factor)), target, target.size(), 0, 0, cv::INTER_AREA);
-  return out;
-}
-
-}  // namespace
 
 int photo_downsample(const std::vector<Camera>& cameras, int max_side) {
   if (max_side <= 0) return 1;
@@ -48,9 +34,9 @@ std::vector<Image8> frame_photos(const TakeInfo& take, int frame, int factor, Th
     if (!take.has_image(camera, frame)) return;
     const Image8 raw = read_image_u8(take.image_path(camera, frame));
     if (bayer && factor % 2 == 0)
-      photos[size_t(c)] = area_downsampled(mvs::debayer_half(raw, take.pixel_format), factor / 2);
+      photos[size_t(c)] = box_downsample_dropping_remainder(mvs::debayer_half(raw, take.pixel_format), factor / 2);
     else
-      photos[size_t(c)] = area_downsampled(bayer ? mvs::debayer(raw, take.pixel_format) : mvs::rgb_of(raw), factor);
+      photos[size_t(c)] = box_downsample_dropping_remainder(bayer ? mvs::debayer(raw, take.pixel_format) : mvs::rgb_of(raw), factor);
   });
   return photos;
 }

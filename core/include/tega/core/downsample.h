@@ -13,4 +13,10 @@ namespace tega {
 // tega::Error unless factor divides both sides.
 Image8 box_downsample(const Image8& image, int factor);
 
+// As box_downsample, for any size: the last width % factor columns and
+// height % factor rows are dropped, so that output pixel x still averages
+// the block around factor * (x + 0.5) - 0.5 (images a stage only looks at,
+// such as tracking's photos and the mattes' recorded frames).
+Image8 box_downsample_dropping_remainder(const Image8& image, int factor);
+
 }  // namespace tega

@@ -16,7 +16,4 @@ namespace tega::matting {
 Image8 read_recorded_rgb(const TakeInfo& take, const std::string& camera, int frame, int width, int height,
                          int downsample = 1);
 
-// `image` shrunk by `factor` by averaging factor x factor blocks.
-Image8 area_downsampled(const Image8& image, int factor);
-
 }  // namespace tega::matting
