@@ -2,6 +2,7 @@
 
 #include "image_tensors.h"
 #include "tega/core/error.h"
+#include "tega/core/landmark_box.h"
 
 namespace tega::tools {
 
@@ -12,8 +13,7 @@ std::optional<Eigen::AlignedBox2d> landmark_detection_box(
     if (!landmark) return std::nullopt;
     box.extend(*landmark);
   }
-  const Eigen::Vector2d grow = kLandmarkBoxGrowth / 2 * box.sizes();
-  return Eigen::AlignedBox2d(box.min() - grow, box.max() + grow);
+  return grown_landmark_box(box);
 }
 
 double detected_landmark_error_px(const LandmarkPredictor& predictor, const at::Tensor& render,

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "tega/core/image.h"
+#include "tega/core/landmark_box.h"
 
 namespace tega::tracking {
 
@@ -20,13 +21,8 @@ constexpr int kLandmarkCount = 68;
 // A face's bounding box in pixels: min = top-left, max = bottom-right.
 using FaceBox = Eigen::AlignedBox2d;
 
-// The box tega's predictors are trained on and given: the landmarks' own
-// bounding box grown by 7.5 % of its size on each side (15 % in all). A
-// predictor learns its box's framing, so training and detection must agree.
-inline FaceBox grown_landmark_box(const FaceBox& landmarks) {
-  const Eigen::Vector2d margin = 0.075 * landmarks.sizes();
-  return FaceBox(landmarks.min() - margin, landmarks.max() + margin);
-}
+// The box tega's predictors are trained on and given: tega::grown_landmark_box
+// (tega/core/landmark_box.h).
 
 class LandmarkDetector {
  public:

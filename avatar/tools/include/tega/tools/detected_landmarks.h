@@ -4,12 +4,10 @@
 // on the render and on the ground truth, both in the same face box, and the
 // error is the mean pixel distance between the two detections over the 68
 // points. The box is the one tracking's predictors are trained with
-// (tracking::grown_landmark_box, which tega_tools cannot include where dlib is
-// absent): the bounding box of the tracked mesh's 68 landmark vertices
-// projected into the view, grown by kLandmarkBoxGrowth of its size, half on
-// each side. The same
-// box for both images means that only what the detector reads from the
-// pixels moves the points.
+// (grown_landmark_box): the bounding box of the tracked mesh's 68 landmark
+// vertices projected into the view, grown by 7.5 % of its size on each side.
+// The same box for both images means that only what the detector reads from
+// the pixels moves the points.
 
 #include <ATen/ATen.h>
 
@@ -23,8 +21,6 @@
 #include "tega/core/image.h"
 
 namespace tega::tools {
-
-constexpr double kLandmarkBoxGrowth = 0.15;
 
 // The 68 landmarks (pixels, the markup's order) of the face in the box of an 8-bit RGB image.
 using LandmarkPredictor = std::function<std::vector<Eigen::Vector2d>(const Image8&, const Eigen::AlignedBox2d&)>;
