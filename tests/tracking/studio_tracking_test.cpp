@@ -121,6 +121,11 @@ void write_true_scans(const fs::path& capture, const fs::path& meshes) {
   }
 }
 
+TEST(StudioTracking, OnlyTheEyelidsAndTheJawHaveACorrelationTarget) {
+  for (const char* name : {"eyeBlink_L", "eyeBlink_R", "jawOpen", "jawLeft"}) EXPECT_TRUE(has_correlation_target(name));
+  for (const char* name : {"browInnerUp_L", "mouthSmile_R", "eyeWide_L", ""}) EXPECT_FALSE(has_correlation_target(name));
+}
+
 TEST(StudioTracking, TracksTegasOwnMeshesWithinTheTargets) {
   const auto shared = test::shared_data_dir();
   if (!shared || !fs::exists(*shared / "ict-facekit" / "vertex_indices.json"))

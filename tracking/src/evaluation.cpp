@@ -141,4 +141,8 @@ TrackScores score_against_studio(const fs::path& tracked, const fs::path& captur
   return TakeTruth(capture, take).score(scored, &neutral);
 }
 
+bool has_correlation_target(const std::string& expression) {
+  return expression.rfind("eyeBlink", 0) == 0 || expression.rfind("jaw", 0) == 0;
+}
+
 }  // namespace tega::tracking

@@ -42,6 +42,11 @@ struct TrackScores {
   std::map<std::string, double> correlation;  // per true expression that varies: Pearson r over the frames
 };
 
+// Whether an expression's correlation has a target (r >= 0.9, docs/tracking.md):
+// the eyelids' (eyeBlink_*) and the jaw's (jaw*), which the images must move;
+// the rest (brows, smiles) are reported without one.
+bool has_correlation_target(const std::string& expression);
+
 // The studio's ground truth in tega track's layout (docs/layouts.md#tracked-meshes):
 // its template as the subject (identity.json, identity_neutral.obj) and the
 // true coarse meshes and poses as tracked frames of `takes` (empty: every
