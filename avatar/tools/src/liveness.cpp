@@ -51,9 +51,9 @@ double expression_mm(const Vertices& world, const RigidTransform& head_to_world,
 // The true coarse mesh and head pose of a dataset frame of a virtual-studio
 // capture: ground_truth/<take>/frames.json and the coarse meshes it names
 // (docs/virtual-studio.md#takes), for dataset frames named <take>_<frame>.
-class StudioTruth {
+class TrueMeshes {
  public:
-  explicit StudioTruth(const std::filesystem::path& capture) : root_(capture / "ground_truth") {
+  explicit TrueMeshes(const std::filesystem::path& capture) : root_(capture / "ground_truth") {
     if (!std::filesystem::is_directory(root_))
       throw Error(capture, "no ground_truth/ folder: --truth takes a tega synth capture (with truth_apart, its "
                            "CAPTURE.truth/)");
@@ -68,7 +68,9 @@ class StudioTruth {
       throw Error(root_, "dataset frame '" + f.id + "' is not <take>_<6-digit frame> of a virtual-studio take");
     const nlohmann::json& take = take_of(file);
     const int index = std::stoi(number);
-    for (const auto& entry : take.value("frames", nlohmann::json::array())) {
+    const auto frames = take.find("frames");
+    if (frames == take.end() || !frames->is_array()) throw Error(file, "has no frames array");
+    for (const auto& entry : *frames) {
       if (entry.value("index", -1) != index) continue;
       Eigen::Matrix<double, 3, 4> pose;
       try {
@@ -184,7 +186,7 @@ Liveness inspect_avatar(trainer::TrainedAvatar& avatar, const Dataset& dataset, 
 
   std::vector<double> expression, deformation, shading_change;
   at::Tensor shading_sum, shading_square_sum;
-  std::optional<StudioTruth> truth;
+  std::optional<TrueMeshes> truth;
   if (!options.truth.empty()) truth.emplace(options.truth);
   const std::set<std::string> held_out(dataset.test.frames.begin(), dataset.test.frames.end());
   SquaredErrors train_errors, test_errors;
