@@ -334,11 +334,13 @@ std::string liveness_markdown(const Liveness& l, const std::string& name) {
   if (!l.frames.empty() && l.frames.front().mesh_error_mm) {
     out += "- against the true meshes: the dataset's meshes put the Gaussians " +
            fixed(rms_over_frames(l, &FrameLiveness::mesh_error_mm), 3) + " mm (RMS) from where the true meshes would";
-    out += l.error_undone_train || l.error_undone_test
-               ? "; with the field " + fixed(rms_over_frames(l, &FrameLiveness::corrected_error_mm), 3) + " mm: " +
-                     fixed(100.0 * l.error_undone_train.value_or(std::nan("")), 1) + " % of it undone on training frames, " +
-                     fixed(100.0 * l.error_undone_test.value_or(std::nan("")), 1) + " % on held-out frames\n"
-               : "\n";
+    if (l.error_undone_train || l.error_undone_test) {
+      out += "; with the field " + fixed(rms_over_frames(l, &FrameLiveness::corrected_error_mm), 3) + " mm:";
+      if (l.error_undone_train) out += " " + fixed(100.0 * *l.error_undone_train, 1) + " % of it undone on training frames";
+      if (l.error_undone_train && l.error_undone_test) out += ",";
+      if (l.error_undone_test) out += " " + fixed(100.0 * *l.error_undone_test, 1) + " % on held-out frames";
+    }
+    out += "\n";
   }
   out += "- mean gradient norm of L1 + D-SSIM per part:";
   for (const auto& g : l.gradients) out += " " + g.part + " " + scientific(g.mean_norm) + ";";
