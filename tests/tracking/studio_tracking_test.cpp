@@ -157,7 +157,9 @@ TEST(StudioTracking, TracksTegasOwnMeshesWithinTheTargets) {
   options.threads = 2;
   const TrackSummary summary = track_capture({capture, {}, dir / "meshes", dir / "tracked", {}}, options);
   EXPECT_EQ(summary.frames_tracked, kFrames);
-  const TrackScores scores = score_against_studio(dir / "tracked", capture, "expressions");
+  // One truth for every scoring below: its face regions cost a depth render per camera and frame.
+  const TakeTruth truth(capture, "expressions");
+  const TrackScores scores = score_against_studio(dir / "tracked", truth);
   print_scores("tega's MVS meshes", scores);
   expect_within(scores, {0.002, 0.007, 1.0, 0.95, 0.85});
   expect_eyelids_seen(dir / "tracked" / "expressions", capture);
@@ -202,7 +204,7 @@ TEST(StudioTracking, TracksTegasOwnMeshesWithinTheTargets) {
   with_landmarks.landmarks.model = (dir / "predictor.dat").string();
   track_capture({capture, {}, dir / "meshes", dir / "tracked_with_landmarks", {}}, with_landmarks);
   const TrackScores landmarked =
-      score_against_studio(dir / "tracked_with_landmarks", capture, "expressions");
+      score_against_studio(dir / "tracked_with_landmarks", truth);
   print_scores("tega's MVS meshes, with landmarks", landmarked);
   expect_within(landmarked, Bounds{0.002, 0.007, 1.0, 0.95, 0.85});
   const auto with_points =
@@ -216,7 +218,7 @@ TEST(StudioTracking, TracksTegasOwnMeshesWithinTheTargets) {
   reuse.identity = (dir / "tracked" / "identity.json").string();
   reuse.flow.enabled = true;
   track_capture({capture, {}, dir / "true_meshes", dir / "tracked_on_truth", {}}, reuse);
-  const TrackScores bound = score_against_studio(dir / "tracked_on_truth", capture, "expressions");
+  const TrackScores bound = score_against_studio(dir / "tracked_on_truth", truth);
   print_scores("true meshes, with flow", bound);
   expect_within(bound, {0.002, 0.005, 1.0, 0.95, 0.85});
 
@@ -227,10 +229,10 @@ TEST(StudioTracking, TracksTegasOwnMeshesWithinTheTargets) {
   move_tracked_take(dir / "tracked_on_truth" / "expressions", dir / "tracked_elsewhere" / "expressions",
                     calibrated_world);
   const TrackScores elsewhere =
-      score_against_studio(dir / "tracked_elsewhere", capture, "expressions", calibrated_world.inverse());
+      score_against_studio(dir / "tracked_elsewhere", truth, calibrated_world.inverse());
   EXPECT_NEAR(elsewhere.vertex_median_m, bound.vertex_median_m, 1e-6);
   EXPECT_NEAR(elsewhere.rotation_median_deg, bound.rotation_median_deg, 1e-3);
-  EXPECT_GT(score_against_studio(dir / "tracked_elsewhere", capture, "expressions").rotation_median_deg, 20);
+  EXPECT_GT(score_against_studio(dir / "tracked_elsewhere", truth).rotation_median_deg, 20);
   const auto flowed = nlohmann::json::parse(read_text_file(dir / "tracked_on_truth" / "expressions" / "000004.json"));
   EXPECT_GT(flowed["residuals"]["flow_points"].get<int>(), 1000);
   EXPECT_LT(flowed["residuals"]["flow_rms_px"].get<double>(), 5.0);

@@ -126,6 +126,12 @@ TrackScores TakeTruth::score(const std::vector<ScoredFrame>& tracked, const Vert
 
 TrackScores score_against_studio(const fs::path& tracked, const fs::path& capture, const std::string& take,
                                  const RigidTransform& tracked_to_truth) {
+  return score_against_studio(tracked, TakeTruth(capture, take), tracked_to_truth);
+}
+
+TrackScores score_against_studio(const fs::path& tracked, const TakeTruth& truth,
+                                 const RigidTransform& tracked_to_truth) {
+  const std::string& take = truth.take();
   std::vector<ScoredFrame> scored;
   for (const TrackedFrame& frame : read_tracked_take(tracked, take)) {
     if (!frame.tracked()) continue;
@@ -136,9 +142,9 @@ TrackScores score_against_studio(const fs::path& tracked, const fs::path& captur
   }
   if (scored.empty()) throw Error(tracked / take, "has no tracked frame to score");
   const fs::path neutral_file = tracked / "identity_neutral.obj";
-  if (!fs::exists(neutral_file)) return TakeTruth(capture, take).score(scored);
+  if (!fs::exists(neutral_file)) return truth.score(scored);
   const Vertices neutral = read_obj(neutral_file).positions;
-  return TakeTruth(capture, take).score(scored, &neutral);
+  return truth.score(scored, &neutral);
 }
 
 bool has_correlation_target(const std::string& expression) {

@@ -72,6 +72,7 @@ class TakeTruth {
  public:
   TakeTruth(const std::filesystem::path& capture, const std::string& take);
   ~TakeTruth();
+  const std::string& take() const { return take_; }
   // `subject_neutral`: the tracked subject's neutral (head space, the model's topology), or null.
   TrackScores score(const std::vector<ScoredFrame>& frames, const Vertices* subject_neutral = nullptr) const;
 
@@ -97,5 +98,9 @@ class TakeTruth {
 // calibrated rig has its own, its first camera's by default) into the studio's.
 TrackScores score_against_studio(const std::filesystem::path& tracked, const std::filesystem::path& capture,
                                  const std::string& take, const RigidTransform& tracked_to_truth = {});
+// The same against a truth already loaded, which keeps the face regions it
+// found: for scoring several trackings of one take.
+TrackScores score_against_studio(const std::filesystem::path& tracked, const TakeTruth& truth,
+                                 const RigidTransform& tracked_to_truth = {});
 
 }  // namespace tega::tracking
