@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -12,6 +11,7 @@
 #include "tega/core/error.h"
 #include "tega/core/image.h"
 #include "tega/core/image_header.h"
+#include "tega/core/json_file.h"
 #include "tega/core/take.h"
 #include "test_support.h"
 
@@ -19,8 +19,6 @@ namespace tega::capture {
 namespace {
 
 namespace fs = std::filesystem;
-
-nlohmann::json read_json(const fs::path& file) { return nlohmann::json::parse(std::ifstream(file)); }
 
 TakeRequest request(const std::string& name, int frames, Trigger trigger = Trigger::free_run) {
   TakeRequest r;
@@ -77,12 +75,12 @@ TEST(FakeRig, ThirteenCamerasRecordCompleteFrameSetsHoldingTheCamerasPixels) {
   }
   EXPECT_EQ(checked, 12 * 13);
 
-  const auto manifest = read_json(capture / "takes/expressions/manifest.json");
+  const auto manifest = read_json_file(capture / "takes/expressions/manifest.json");
   EXPECT_EQ(manifest["frames"], 12);
   EXPECT_EQ(manifest["synchronised"], false);
   EXPECT_EQ(manifest["cameras"][4]["settings_read_back"]["PixelFormat"], "Mono8");
   EXPECT_EQ(manifest["cameras"][4]["frames_written"], 12);
-  const auto listed = read_json(capture / "capture.json");
+  const auto listed = read_json_file(capture / "capture.json");
   EXPECT_EQ(listed["takes"][0]["name"], "expressions");
   EXPECT_EQ(listed["takes"][0]["frames"], 12);
 }
@@ -96,8 +94,8 @@ TEST(FakeRig, HardwareTriggerGroupsByFrameIdAndIsMarkedSynchronised) {
   EXPECT_EQ(outcome.incomplete_sets, 0);
   for (const auto& row : test::read_frame_sets(capture / "takes/rom"))
     if (row.at("status") == "complete") EXPECT_EQ(row.at("cam00_frame_id"), row.at("cam02_frame_id"));
-  EXPECT_EQ(read_json(capture / "takes/rom/manifest.json")["synchronised"], true);
-  EXPECT_EQ(read_json(capture / "takes/rom/manifest.json")["cameras"][0]["settings_read_back"]["TriggerSource"],
+  EXPECT_EQ(read_json_file(capture / "takes/rom/manifest.json")["synchronised"], true);
+  EXPECT_EQ(read_json_file(capture / "takes/rom/manifest.json")["cameras"][0]["settings_read_back"]["TriggerSource"],
             "Line0");
 }
 
@@ -144,7 +142,7 @@ TEST(FakeRig, AWriteErrorStopsTheTakeAndKeepsWhatWasWrittenListed) {
   EXPECT_EQ(on_disk, 22);
   for (const auto& entry : fs::recursive_directory_iterator(capture / "takes/full"))
     EXPECT_EQ(entry.path().string().find(".tmp"), std::string::npos) << entry.path();
-  const auto manifest = read_json(capture / "takes/full/manifest.json");
+  const auto manifest = read_json_file(capture / "takes/full/manifest.json");
   EXPECT_NE(manifest["error"].get<std::string>().find("injected"), std::string::npos);
   validate_capture(capture.path());
 }

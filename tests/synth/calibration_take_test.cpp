@@ -23,7 +23,6 @@ namespace {
 namespace fs = std::filesystem;
 
 using test::pose_from_json;
-using test::read_json;
 
 TEST(CalibrationTake, OpenCvFindsTheCharucoCornersWhereTheGroundTruthPutsThem) {
   tega::test::TempDir tmp;
@@ -39,7 +38,7 @@ TEST(CalibrationTake, OpenCvFindsTheCharucoCornersWhereTheGroundTruthPutsThem) {
   const fs::path root = tmp / "capture";
   render_virtual_studio(o, root);
   const Rig rig = read_rig_json(root / "rig.json");
-  const nlohmann::json gt = read_json(root / "ground_truth/calibration/frames.json");
+  const nlohmann::json gt = read_json_file(root / "ground_truth/calibration/frames.json");
   const CharucoBoardSpec spec;
   ASSERT_EQ(gt["board"]["squares_x"], spec.squares_x);
   const auto dictionary = cv::aruco::getPredefinedDictionary(cv::aruco::DICT_5X5_100);

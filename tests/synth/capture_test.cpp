@@ -52,7 +52,6 @@ const fs::path& capture() {
 }
 
 using test::pose_from_json;
-using test::read_json;
 
 // Pixels whose centre lies inside a projected triangle (either winding): an
 // independent, plain rasterization of the ground-truth mesh.
@@ -125,7 +124,7 @@ TEST(Capture, AlphaDiffersFromCaptureOnlyByTheBackground) {
 }
 
 TEST(Capture, GroundTruthSequenceHasBlinksJawAndHeadMotion) {
-  const nlohmann::json frames = read_json(capture() / "ground_truth/expressions/frames.json")["frames"];
+  const nlohmann::json frames = read_json_file(capture() / "ground_truth/expressions/frames.json")["frames"];
   ASSERT_EQ(frames.size(), 10u);
   double blink_max = 0, blink_min = 1, jaw_max = 0, jaw_min = 1, max_turn_deg = 0;
   const RigidTransform first = pose_from_json(frames[0]["head_to_world"]);
@@ -146,7 +145,7 @@ TEST(Capture, GroundTruthSequenceHasBlinksJawAndHeadMotion) {
 TEST(Capture, GroundTruthCoarseMeshIsThePosedTemplate) {
   const fs::path root = capture();
   const Mesh templ = read_obj(root / "ground_truth/head/template.obj");
-  const nlohmann::json frames = read_json(root / "ground_truth/expressions/frames.json")["frames"];
+  const nlohmann::json frames = read_json_file(root / "ground_truth/expressions/frames.json")["frames"];
   // Frame 0 is neutral up to the head pose: the tracked mesh is the template, posed.
   for (const auto& [name, value] : frames[0]["expression"].items()) ASSERT_LT(double(value), 1e-3) << name;
   const RigidTransform pose = pose_from_json(frames[0]["head_to_world"]);
@@ -175,10 +174,10 @@ TEST(Capture, DatasetValidatesWithHeldOutTakeAndCamera) {
 TEST(Capture, WritesTheTakesItDescribes) {
   const fs::path root = capture();
   EXPECT_NO_THROW(tega::validate_capture(root));
-  const nlohmann::json c = read_json(root / "capture.json");
+  const nlohmann::json c = read_json_file(root / "capture.json");
   EXPECT_EQ(c["cameras"].size(), 3u);
   for (const auto& take : c["takes"]) {
-    const nlohmann::json t = read_json(root / "takes" / std::string(take["name"]) / "take.json");
+    const nlohmann::json t = read_json_file(root / "takes" / std::string(take["name"]) / "take.json");
     EXPECT_EQ(t["kind"], take["kind"]);
     EXPECT_EQ(t["frames"], take["frames"]);
     for (int f = 0; f < int(t["frames"]); ++f)
@@ -211,7 +210,7 @@ TEST(Capture, RefusesToOverwriteAnExistingDirectoryUnlessAsked) {
 #ifndef TEGA_SYNTH_HAVE_OPENCV
 TEST(Capture, CalibrationTakeIsSkippedWithoutOpenCv) {
   EXPECT_FALSE(fs::exists(capture() / "takes/calibration"));
-  EXPECT_TRUE(read_json(capture() / "capture.json")["calibration_skipped"].get<bool>());
+  EXPECT_TRUE(read_json_file(capture() / "capture.json")["calibration_skipped"].get<bool>());
 }
 #endif
 

@@ -1,18 +1,12 @@
 #pragma once
 // Reading the virtual studio's ground-truth JSON files in the synth tests.
 
-#include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "tega/core/json_file.h"
 #include "tega/core/rig.h"
 
 namespace tega::synth::test {
-
-inline nlohmann::json read_json(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  return nlohmann::json::parse(in);
-}
 
 // A 3x4 [R | t] written as rows.
 inline RigidTransform pose_from_json(const nlohmann::json& rows) {

@@ -24,7 +24,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using test::pose_from_json;
-using test::read_json;
 
 constexpr int kFrames = 6;
 const char* const kTake = "expressions";
@@ -67,7 +66,7 @@ Vertices dataset_mesh(const fs::path& dir, int f) {
 RigidTransform truth_pose(const fs::path& dir, int f) {
   static std::map<fs::path, nlohmann::json> cache;
   auto& j = cache[dir];
-  if (j.is_null()) j = read_json(dir / "ground_truth" / kTake / "frames.json");
+  if (j.is_null()) j = read_json_file(dir / "ground_truth" / kTake / "frames.json");
   return pose_from_json(j["frames"][f]["head_to_world"]);
 }
 
@@ -99,7 +98,7 @@ TEST(TrackingError, OffByDefaultTheDatasetMeshesAreTheTrueCoarseMeshes) {
               file_bytes(dir / "ground_truth" / kTake / "coarse" / (frame_id(f) + ".bin")))
         << f;
   EXPECT_FALSE(fs::exists(dir / "dataset/tracking_error.json"));
-  EXPECT_FALSE(read_json(dir / "capture.json").contains("tracking_error"));
+  EXPECT_FALSE(read_json_file(dir / "capture.json").contains("tracking_error"));
 }
 
 TEST(TrackingError, OffsetFieldHasTheRequestedRmsIsSmoothAndMovesEyeballsRigidly) {
@@ -245,8 +244,8 @@ TEST(TrackingError, LipMisfitMovesOnlyWhatTheJawAndMouthShapesMove) {
   }
   EXPECT_GT(moved_most, 1e-3);
   // The record says which coefficients the meshes used.
-  const nlohmann::json record = read_json(r.dir / "dataset/tracking_error.json");
-  const nlohmann::json truth = read_json(r.dir / "ground_truth" / kTake / "frames.json");
+  const nlohmann::json record = read_json_file(r.dir / "dataset/tracking_error.json");
+  const nlohmann::json truth = read_json_file(r.dir / "ground_truth" / kTake / "frames.json");
   int differ = 0;
   for (int f = 0; f < kFrames; ++f)
     differ += record["frames"][f]["expression"]["jawOpen"] != truth["frames"][f]["expression"]["jawOpen"];
@@ -297,12 +296,12 @@ TEST(TrackingError, ImagesAndTruthAreIdenticalWithAndWithoutErrorsWhichAreRecord
   EXPECT_EQ(meshes_differ, kFrames);
   EXPECT_NO_THROW(validate_dataset(read_dataset(r.dir / "dataset")));
 
-  const nlohmann::json record = read_json(r.dir / "dataset/tracking_error.json");
+  const nlohmann::json record = read_json_file(r.dir / "dataset/tracking_error.json");
   EXPECT_EQ(record["options"]["offset_m"], 0.002);
   EXPECT_EQ(record["options"]["lag"], 0.5);
   ASSERT_EQ(record["frames"].size(), size_t(kFrames));
   for (const auto& frame : record["frames"]) EXPECT_NEAR(frame["offset_rms_m"].get<double>(), 0.002, 1e-6);
-  EXPECT_EQ(read_json(r.dir / "capture.json")["tracking_error"], record["options"]);
+  EXPECT_EQ(read_json_file(r.dir / "capture.json")["tracking_error"], record["options"]);
 }
 
 }  // namespace
