@@ -34,6 +34,20 @@ at::Tensor l1_image_loss(const at::Tensor& rendered, const at::Tensor& target) {
   return (rendered - target).abs().mean();
 }
 
+at::Tensor pyramid_l1_loss(const at::Tensor& rendered, const at::Tensor& target, int levels) {
+  TORCH_CHECK(rendered.sizes() == target.sizes(), "pyramid L1: sizes differ, ", rendered.sizes(), " vs ", target.sizes());
+  TORCH_CHECK(levels >= 1, "pyramid L1: levels must be at least 1, got ", levels);
+  at::Tensor a = as_batch(rendered), b = as_batch(target);
+  at::Tensor sum = at::zeros({}, a.options());
+  for (int level = 1; level <= levels; ++level) {
+    TORCH_CHECK(a.size(2) >= 2 && a.size(3) >= 2, "pyramid L1: a ", rendered.sizes(), " image has no level ", level);
+    a = at::avg_pool2d(a, {2, 2});
+    b = at::avg_pool2d(b, {2, 2});
+    sum = sum + (a - b).abs().mean();
+  }
+  return sum / levels;
+}
+
 at::Tensor ssim(const at::Tensor& a_in, const at::Tensor& b_in) {
   TORCH_CHECK(a_in.sizes() == b_in.sizes(), "SSIM: sizes differ, ", a_in.sizes(), " vs ", b_in.sizes());
   const at::Tensor a = as_batch(a_in), b = as_batch(b_in);

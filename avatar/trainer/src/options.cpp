@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include "tega/core/error.h"
 
@@ -61,10 +62,11 @@ void apply_baseline(TrainOptions& options, const std::string& baseline) {
   if (baseline != "gaussian-avatars") {
     throw Error("unknown baseline '" + baseline + "'; known: " + joined(baseline_names()));
   }
-  // GA's rigging, no networks, no perceptual term.
+  // GA's rigging, no networks, GA's losses (no perceptual or pyramid term).
   options.binding = "rigged";
   options.deformation_field = options.dynamic_shading = false;
   options.loss.vgg_weights.clear();
+  options.loss.pyramid_l1 = 0;
   // GA's adaptive density control as fractions of its 600K iterations:
   // from 10K to the end, every 2K, opacity reset every 60K; at most ~200K.
   options.densify.enabled = true;
@@ -78,6 +80,12 @@ void apply_baseline(TrainOptions& options, const std::string& baseline) {
 void validate_train_options(const TrainOptions& options) {
   if (options.binding != "uvd" && options.binding != "triangle" && options.binding != "rigged") {
     throw Error("binding must be 'uvd', 'triangle' or 'rigged', not '" + options.binding + "'");
+  }
+  if (options.loss.pyramid_l1 < 0 || (options.loss.pyramid_l1 > 0 && options.loss.pyramid_levels < 1)) {
+    std::ostringstream what;
+    what << "loss.pyramid_l1 must be at least 0 and loss.pyramid_levels at least 1 (got " << options.loss.pyramid_l1
+         << " and " << options.loss.pyramid_levels << ")";
+    throw Error(what.str());
   }
   if (options.binding == "rigged" && (options.deformation_field || options.dynamic_shading)) {
     throw Error("binding: rigged (GaussianAvatars) has no UVD space for the networks: set deformation_field and "

@@ -281,6 +281,8 @@ class Run {
       RECORD_FUNCTION("tega::image_losses", std::vector<c10::IValue>());
       loss = options_.loss.l1 * nn::l1_image_loss(rendered, target) +
              options_.loss.dssim * nn::dssim_loss(rendered, target);
+      if (options_.loss.pyramid_l1 > 0)
+        loss = loss + options_.loss.pyramid_l1 * nn::pyramid_l1_loss(rendered, target, options_.loss.pyramid_levels);
     }
     const double vgg_weight = schedules::vgg_weight(options_.loss, iteration_, options_.iterations);
     if (vgg_ && vgg_weight > 0) loss = loss + vgg_weight * (*vgg_)(rendered.unsqueeze(0), target.unsqueeze(0));

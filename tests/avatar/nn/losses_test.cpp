@@ -16,6 +16,39 @@ TEST(L1Loss, IsTheMeanAbsoluteDifference) {
   EXPECT_FLOAT_EQ(l1_image_loss(a, b).item<float>(), (1 + 0 + 1 + 0.5f) / 4);
 }
 
+TEST(PyramidL1Loss, AveragesTheL1OfTheCoarserLevels) {
+  // One channel, 4x4: level 1 is the 2x2 block means, level 2 the image mean.
+  const at::Tensor a = at::arange(16, at::kFloat).reshape({1, 4, 4}) / 16;
+  const at::Tensor b = at::zeros({1, 4, 4});
+  const double level1 = (2.5 + 4.5 + 10.5 + 12.5) / 4 / 16;
+  const double level2 = 7.5 / 16;
+  EXPECT_NEAR(pyramid_l1_loss(a, b, 2).item<double>(), (level1 + level2) / 2, 1e-6);
+  EXPECT_NEAR(pyramid_l1_loss(a, b, 1).item<double>(), level1, 1e-6);
+}
+
+TEST(PyramidL1Loss, SeesAMisalignmentButNotTextureFinerThanItsLevels) {
+  // A 1-pixel checkerboard and its 1-pixel shift differ everywhere at full
+  // resolution and nowhere in 2x2 means; a 16-pixel square moved by 4 pixels
+  // differs at every level.
+  const at::Tensor ramp = at::arange(32, at::kFloat);
+  const at::Tensor checker = at::remainder(ramp.unsqueeze(1) + ramp.unsqueeze(0), 2).unsqueeze(0);
+  const at::Tensor shifted = at::roll(checker, {1}, {2});
+  EXPECT_FLOAT_EQ(l1_image_loss(checker, shifted).item<float>(), 1.0f);
+  EXPECT_NEAR(pyramid_l1_loss(checker, shifted, 3).item<float>(), 0.0f, 1e-6);
+
+  at::Tensor square = at::zeros({1, 32, 32});
+  square.slice(1, 8, 24).slice(2, 8, 24).fill_(1);
+  const at::Tensor moved = at::roll(square, {4}, {2});
+  EXPECT_GT(pyramid_l1_loss(square, moved, 3).item<float>(), 0.05f);
+}
+
+TEST(PyramidL1Loss, NamesALevelTheImageCannotHave) {
+  const at::Tensor a = at::zeros({3, 4, 4});
+  EXPECT_NO_THROW(pyramid_l1_loss(a, a, 2));
+  EXPECT_THROW(pyramid_l1_loss(a, a, 3), c10::Error);
+  EXPECT_THROW(pyramid_l1_loss(a, a, 0), c10::Error);
+}
+
 TEST(Ssim, IsOneForIdenticalImages) {
   const at::Tensor image = at::rand({3, 24, 32});
   EXPECT_NEAR(ssim(image, image).item<float>(), 1.0f, 1e-5);

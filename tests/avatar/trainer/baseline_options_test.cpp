@@ -12,11 +12,13 @@ namespace {
 TEST(BaselineOptions, GaussianAvatarsIsRiggedWithoutNetworksOnGasSchedule) {
   TrainOptions o;
   o.loss.vgg_weights = "vgg16.safetensors";
+  o.loss.pyramid_l1 = 0.5;
   apply_baseline(o, "gaussian-avatars");
   EXPECT_EQ(o.binding, "rigged");
   EXPECT_FALSE(o.deformation_field);
   EXPECT_FALSE(o.dynamic_shading);
   EXPECT_TRUE(o.loss.vgg_weights.empty());
+  EXPECT_EQ(o.loss.pyramid_l1, 0);  // GA's losses: L1 + D-SSIM and its regularisers
   EXPECT_EQ(o.densify.max_gaussians, 200000);
   // 600K iterations: densify from 10K to the end every 2K, reset opacity every 60K.
   EXPECT_EQ(at_fraction(o.densify.start, 600000), 10000);
@@ -54,6 +56,18 @@ TEST(BaselineOptions, RiggedGaussiansRefuseTheNetworks) {
   o.dynamic_shading = false;
   EXPECT_NO_THROW(validate_train_options(o));
   o.binding = "free";
+  EXPECT_THROW(validate_train_options(o), Error);
+}
+
+TEST(BaselineOptions, APyramidTermNeedsAWeightOfZeroOrMoreAndALevel) {
+  TrainOptions o;
+  o.loss.pyramid_l1 = 0.5;
+  EXPECT_NO_THROW(validate_train_options(o));
+  o.loss.pyramid_levels = 0;
+  EXPECT_THROW(validate_train_options(o), Error);
+  o.loss.pyramid_l1 = 0;
+  EXPECT_NO_THROW(validate_train_options(o));  // off: its levels are unused
+  o.loss.pyramid_l1 = -1;
   EXPECT_THROW(validate_train_options(o), Error);
 }
 

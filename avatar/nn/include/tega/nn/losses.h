@@ -14,6 +14,14 @@ namespace tega::nn {
 // Mean absolute difference.
 at::Tensor l1_image_loss(const at::Tensor& rendered, const at::Tensor& target);
 
+// Mean over `levels` coarser scales (2x, 4x, ... box averages) of the mean
+// absolute difference: L1 on an image pyramid without its finest level. A
+// misalignment wider than the skin's texture gives L1 and D-SSIM at full
+// resolution no direction to move in; on the coarse levels it does. It stands
+// in for the coarse gradients of the paper's VGG term when no weights exist.
+// An image side that a level cannot halve drops its last pixel (average pooling).
+at::Tensor pyramid_l1_loss(const at::Tensor& rendered, const at::Tensor& target, int levels);
+
 // Mean SSIM as in 3DGS: 11x11 Gaussian window (σ = 1.5) applied per channel
 // by conv2d with zero padding (so the output keeps the image size),
 // C1 = 0.01², C2 = 0.03² for a data range of 1. Plain torch ops: the

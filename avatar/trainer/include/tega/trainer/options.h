@@ -68,6 +68,8 @@ struct LossOptions {
   double dssim = 0.2;
   std::string vgg_weights;            // safetensors of torchvision's VGG-16 features; "" = no VGG term
   double vgg_start = 0.5;             // fraction of iterations before which λ_VGG = 0
+  double pyramid_l1 = 0.0;            // 0 = off (the paper has no such term)
+  int pyramid_levels = 4;
   double smoothness_initial = 1.0;
   double smoothness_final = 0.1;      // reached at half of training
   int64_t smoothness_samples = 100000;
@@ -83,6 +85,10 @@ struct LossOptions {
     v("dssim", dssim, "Weight of the D-SSIM term.");
     v("vgg_weights", vgg_weights, "VGG-16 weight file (safetensors, docs/networks-and-losses.md). Empty: the perceptual term is off (the run log says so).");
     v("vgg_start", vgg_start, "Fraction of training after which the VGG term starts at 0.01, growing exponentially to 0.1.");
+    v("pyramid_l1", pyramid_l1,
+      "Weight of L1 on the 2x, 4x, ... box-averaged images (mean over the levels): coarse gradients for "
+      "misalignments wider than the skin's texture, a stand-in for the VGG term's (docs/networks-and-losses.md). 0 = off.");
+    v("pyramid_levels", pyramid_levels, "Levels of the pyramid L1 term (the coarsest averages 2^levels pixels a side).");
     v("smoothness_initial", smoothness_initial, "Jacobian smoothness weight at the first iteration.");
     v("smoothness_final", smoothness_final, "Smoothness weight from mid-training on (exponential decay before).");
     v("smoothness_samples", smoothness_samples, "Random uvd samples per step for the smoothness term.");
