@@ -55,7 +55,7 @@ std::string error_message(const std::function<void()>& action) {
   return "";
 }
 
-void write_tiny_dataset(const std::filesystem::path& root) {
+void write_tiny_dataset(const std::filesystem::path& root, bool eyeball) {
   Dataset d;
   d.root = root;
   for (const char* name : {"cam00", "cam01"}) {
@@ -92,7 +92,7 @@ void write_tiny_dataset(const std::filesystem::path& root) {
   }
   d.train = {{"smile_000000"}, {"cam00"}};
   d.test = {{"blink_000000"}, {"cam01"}};
-  d.eyeball_faces = {0};
+  if (eyeball) d.eyeball_faces = {0};
   write_dataset_manifest(d);
 }
 

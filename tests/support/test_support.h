@@ -37,8 +37,9 @@ std::string error_message(const std::function<void()>& action);
 // Writes a valid dataset into `root`: a one-triangle template, cameras
 // cam00 (train) and cam01 (test), frames smile_000000 (train) and
 // blink_000000 (test), 8x6 RGBA images whose pixels encode (camera, frame):
-// R = 10 * camera index + frame index.
-void write_tiny_dataset(const std::filesystem::path& root);
+// R = 10 * camera index + frame index. The triangle is an eyeball's (the
+// deformation field leaves it alone) unless `eyeball` is false.
+void write_tiny_dataset(const std::filesystem::path& root, bool eyeball = true);
 
 }  // namespace tega::test
 

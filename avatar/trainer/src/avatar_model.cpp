@@ -105,7 +105,9 @@ PosedGaussians AvatarModel::pose(const FrameInput& frame, const Phase& phase) {
       const nn::FieldWithJacobian field = network->deform(g.uvd, encoded, out.latents, /*with_jacobian=*/true);
       const at::Tensor movable = eyeball_face_mask_.index_select(0, triangle).logical_not().to(means.dtype());
       // Head space -> world: Δ_world = R Δ, J_world = R J (row vectors: Δ Rᵀ).
-      means = means + field.value.matmul(frame.head_rotation.t()) * movable.unsqueeze(1);
+      const at::Tensor applied = field.value * movable.unsqueeze(1);
+      means = means + applied.matmul(frame.head_rotation.t());
+      out.largest_deformation = applied.detach().norm(2, 1).amax();
       // R J_D for every Gaussian as one [3N,3]x[3,3] product: (J_Dᵀ Rᵀ)ᵀ.
       const at::Tensor rotated = field.jacobian.transpose(1, 2).reshape({-1, 3}).matmul(frame.head_rotation.t());
       jacobian = jacobian + rotated.view({-1, 3, 3}).transpose(1, 2) * movable.view({-1, 1, 1});

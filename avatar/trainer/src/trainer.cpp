@@ -158,12 +158,12 @@ class Run {
     double window_loss = 0, window_psnr = 0;
     int window = 0;
     TrainSummary summary;
-    std::optional<StepValues> non_finite;
-    // Adds a finished step's values to the log window, or notes a NaN/Inf.
+    std::optional<StepValues> failed;
+    // Adds a finished step's values to the log window, or notes a failed step.
     const auto take = [&](const std::optional<StepValues>& values) {
       if (!values) return;
-      if (!values->finite) {
-        if (!non_finite) non_finite = values;
+      if (!failure(*values).empty()) {
+        if (!failed) failed = values;
         return;
       }
       window_loss += values->loss;
@@ -179,9 +179,9 @@ class Run {
       const bool log_due = iteration_ % options_.log_every == 0 || iteration_ == last;
       const bool checkpoint_due = iteration_ % options_.checkpoint_every == 0 && iteration_ < last;
       if (log_due || checkpoint_due) take(readout_.pop());
-      if (non_finite) {
-        roll_back(*non_finite);
-        non_finite.reset();
+      if (failed) {
+        roll_back(*failed);
+        failed.reset();
         loader.seek(iteration_);
         rate_first = iteration_;
         rate_start = std::chrono::steady_clock::now();
@@ -299,7 +299,7 @@ class Run {
     // takes the last step's values before every save, and the checkpoint
     // writer refuses non-finite tensors).
     take(readout_.pop());
-    readout_.push(loss, mse, all_finite(loss), iteration_ + 1, loaded.view);
+    readout_.push(loss, mse, all_finite(loss), posed.largest_deformation, iteration_ + 1, loaded.view);
 
     profiler_.section("optimizer");
     {
@@ -354,12 +354,21 @@ class Run {
     return at::stack(finite).all();
   }
 
-  // A NaN/Inf step rolls the run back to its last checkpoint and lowers every
-  // learning rate, once; a second one stops training (nothing non-finite is
-  // ever saved: the loop checks each step before it saves).
+  // What went wrong in a step ("" if nothing): a NaN/Inf, or a deformation
+  // field that ran away.
+  std::string failure(const StepValues& values) const {
+    if (!values.finite) return "the loss or a gradient is NaN/Inf";
+    if (options_.max_deformation > 0 && !(values.largest_deformation <= options_.max_deformation))
+      return "the deformation field moved a Gaussian " + format_number(values.largest_deformation) +
+             " m, more than max_deformation (" + format_number(options_.max_deformation) + " m)";
+    return "";
+  }
+
+  // A failed step rolls the run back to its last checkpoint and lowers every
+  // learning rate, once; a second one stops training (nothing from a failed
+  // step is ever saved: the loop checks each step before it saves).
   void roll_back(const StepValues& values) {
-    const std::string what = "iteration " + std::to_string(values.iteration) +
-                             ": the loss or a gradient is NaN/Inf (camera " +
+    const std::string what = "iteration " + std::to_string(values.iteration) + ": " + failure(values) + " (camera " +
                              dataset_.rig.cameras[values.view.camera].name + ", frame " +
                              dataset_.frames[values.view.frame].id + ")";
     if (rolled_back_) {

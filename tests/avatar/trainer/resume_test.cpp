@@ -14,7 +14,8 @@ namespace {
 
 using namespace tega::trainer;
 
-// Small enough for a few CPU iterations, yet every part of a step runs:
+// Small enough for a few CPU iterations, yet every part of a step runs (the
+// tests write the tiny dataset with its triangle on the skin, for the field):
 // the warm-up ends at iteration 2 and densification runs every 2 iterations.
 TrainOptions tiny_options() {
   TrainOptions o;
@@ -58,7 +59,7 @@ void expect_same_parameters(const std::filesystem::path& a_run, const std::files
 
 TEST(Trainer, ResumeReproducesAnUninterruptedRun) {
   tega::test::TempDir tmp;
-  tega::test::write_tiny_dataset(tmp / "data");
+  tega::test::write_tiny_dataset(tmp / "data", /*eyeball=*/false);
   const TrainOptions options = tiny_options();
 
   const TrainSummary straight = train(tmp / "data", tmp / "straight", options, {});
@@ -91,7 +92,7 @@ TEST(Trainer, ResumeReproducesAnUninterruptedRun) {
 // uninterrupted run does.
 TEST(Trainer, ADamagedLatestCheckpointResumesFromTheOneBefore) {
   tega::test::TempDir tmp;
-  tega::test::write_tiny_dataset(tmp / "data");
+  tega::test::write_tiny_dataset(tmp / "data", /*eyeball=*/false);
   TrainOptions options = tiny_options();
   options.checkpoint_every = 2;
   train(tmp / "data", tmp / "straight", options, {});
@@ -116,7 +117,7 @@ TEST(Trainer, ADamagedLatestCheckpointResumesFromTheOneBefore) {
 
 TEST(Trainer, ExistingRunIsNotOverwrittenByAccident) {
   tega::test::TempDir tmp;
-  tega::test::write_tiny_dataset(tmp / "data");
+  tega::test::write_tiny_dataset(tmp / "data", /*eyeball=*/false);
   TrainOptions options = tiny_options();
   options.iterations = 1;
   train(tmp / "data", tmp / "run", options, {});
@@ -143,7 +144,7 @@ TrainOptions scaled_learning_rates(TrainOptions options, double factor) {
 // run stopped at 3 and resumed with halved learning rates ends.
 TEST(Trainer, ANonFiniteStepRollsBackToTheLastCheckpointWithLowerLearningRates) {
   tega::test::TempDir tmp;
-  tega::test::write_tiny_dataset(tmp / "data");
+  tega::test::write_tiny_dataset(tmp / "data", /*eyeball=*/false);
   TrainOptions options = tiny_options();
   options.checkpoint_every = 3;
   ASSERT_EQ(options.rollback_learning_rate_factor, 0.5);
@@ -169,7 +170,7 @@ TEST(Trainer, ANonFiniteStepRollsBackToTheLastCheckpointWithLowerLearningRates) 
 // Before the first periodic checkpoint, the roll-back goes to the start.
 TEST(Trainer, ANonFiniteFirstStepRollsBackToTheStart) {
   tega::test::TempDir tmp;
-  tega::test::write_tiny_dataset(tmp / "data");
+  tega::test::write_tiny_dataset(tmp / "data", /*eyeball=*/false);
   TrainOptions options = tiny_options();
   train(tmp / "data", tmp / "rolled", options, {.poisoned_iterations = {1}});
   train(tmp / "data", tmp / "reference", scaled_learning_rates(options, 0.5), {});
@@ -180,7 +181,7 @@ TEST(Trainer, ANonFiniteFirstStepRollsBackToTheStart) {
 // the intact checkpoint.
 TEST(Trainer, ASecondNonFiniteStepStopsTraining) {
   tega::test::TempDir tmp;
-  tega::test::write_tiny_dataset(tmp / "data");
+  tega::test::write_tiny_dataset(tmp / "data", /*eyeball=*/false);
   TrainOptions options = tiny_options();
   options.checkpoint_every = 2;
   try {
@@ -200,7 +201,7 @@ TEST(Trainer, ASecondNonFiniteStepStopsTraining) {
 // checkpoint it leaves is the last finite one.
 TEST(Trainer, NonFiniteStepStopsTrainingAndKeepsTheLastFiniteCheckpoint) {
   tega::test::TempDir tmp;
-  tega::test::write_tiny_dataset(tmp / "data");
+  tega::test::write_tiny_dataset(tmp / "data", /*eyeball=*/false);
   TrainOptions options = tiny_options();
   options.learning_rates.sh_dc = 1e30;
   options.checkpoint_every = 1;
@@ -218,11 +219,38 @@ TEST(Trainer, NonFiniteStepStopsTrainingAndKeepsTheLastFiniteCheckpoint) {
     if (tensor.is_floating_point()) EXPECT_TRUE(at::isfinite(tensor).all().item<bool>()) << name;
 }
 
+// A field that runs away stays finite while it renders the head away: an
+// absurd network step size moves the Gaussians kilometres once the field
+// has made its first step (iteration 3), and again after the roll-back. The
+// run stops naming the field and keeps the checkpoint from before it.
+TEST(Trainer, ARunawayDeformationFieldIsRolledBackLikeANonFiniteStep) {
+  tega::test::TempDir tmp;
+  tega::test::write_tiny_dataset(tmp / "data", /*eyeball=*/false);
+  TrainOptions options = tiny_options();
+  options.learning_rates.network = options.learning_rates.network_final = 1e3;
+  options.dynamic_shading = false;  // a runaway shading network blacks the head out before the field moves it
+  options.checkpoint_every = 2;
+  try {
+    train(tmp / "data", tmp / "run", options, {});
+    FAIL() << "expected an error";
+  } catch (const tega::Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(": the deformation field moved a Gaussian"), std::string::npos) << message;
+    EXPECT_NE(message.find("more than max_deformation (0.05 m)"), std::string::npos) << message;
+    EXPECT_NE(message.find("again after a roll-back"), std::string::npos) << message;
+  }
+  EXPECT_EQ(read_checkpoint(tmp / "run/checkpoint.safetensors").iteration(), 2);
+
+  // Unbounded, the same run ends, its field far beyond any tracking error.
+  options.max_deformation = 0;
+  EXPECT_EQ(train(tmp / "data", tmp / "unbounded", options, {}).iterations, options.iterations);
+}
+
 // A capped run ("Ours (200K Gaussians)") never holds more than its cap, not
 // even before its first densification.
 TEST(Trainer, TheGaussianCapBoundsTheInitialSampleToo) {
   tega::test::TempDir tmp;
-  tega::test::write_tiny_dataset(tmp / "data");
+  tega::test::write_tiny_dataset(tmp / "data", /*eyeball=*/false);
   TrainOptions options = tiny_options();
   options.densify.max_gaussians = 40;
   const TrainSummary first = train(tmp / "data", tmp / "run", options, {.stop_at = 1});
@@ -233,7 +261,7 @@ TEST(Trainer, TheGaussianCapBoundsTheInitialSampleToo) {
 
 TEST(Trainer, BadDatasetFailsBeforeTraining) {
   tega::test::TempDir tmp;
-  tega::test::write_tiny_dataset(tmp / "data");
+  tega::test::write_tiny_dataset(tmp / "data", /*eyeball=*/false);
   std::filesystem::remove(tmp / "data/images/cam01/smile_000000.png");
   try {
     train(tmp / "data", tmp / "run", tiny_options(), {});

@@ -47,6 +47,7 @@ struct PosedGaussians {
   at::Tensor opacities;    // [N] in (0,1)
   at::Tensor world_std_per_scale;  // [N,3] world std per unit of exp(log_scale) (no grad)
   nn::Latents latents;     // this frame's latents (undefined when the field is off)
+  at::Tensor largest_deformation;  // 0-d: the longest Δμ applied (metres, no grad); undefined when the field is off
 };
 
 class AvatarModel {

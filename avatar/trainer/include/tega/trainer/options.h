@@ -117,7 +117,8 @@ struct TrainOptions {
   std::string binding = "uvd";                   // uvd (TeGA), triangle or rigged (GaussianAvatars)
   bool antialiased = false;
   int64_t checkpoint_every = 5000;
-  double rollback_learning_rate_factor = 0.5;  // after a NaN/Inf step
+  double rollback_learning_rate_factor = 0.5;  // after a NaN/Inf step or a runaway field
+  double max_deformation = 0.05;                 // metres; 0 = unbounded
   int64_t log_every = 10;
   int loader_threads = 4;
   int prefetch = 8;
@@ -150,8 +151,12 @@ struct TrainOptions {
     v("antialiased", antialiased, "Mip-Splatting-style antialiased rasterization.");
     v("checkpoint_every", checkpoint_every, "Iterations between checkpoints (plus one at the start and one at the end).");
     v("rollback_learning_rate_factor", rollback_learning_rate_factor,
-      "A step whose loss or gradients hold NaN/Inf rolls training back to its last checkpoint, once, and every "
-      "learning rate is multiplied by this from there on; a second such step stops training.");
+      "A step whose loss or gradients hold NaN/Inf, or whose deformation field runs away (max_deformation), rolls "
+      "training back to its last checkpoint, once, and every learning rate is multiplied by this from there on; a "
+      "second such step stops training.");
+    v("max_deformation", max_deformation,
+      "Metres: a step whose deformation field moves a Gaussian further than this has diverged, as a NaN/Inf step has "
+      "(a field that runs away stays finite while it renders the head away). 0: no bound.");
     v("log_every", log_every, "Iterations between progress lines.");
     v("loader_threads", loader_threads, "Threads decoding training images ahead of use.");
     v("prefetch", prefetch, "Training views decoded ahead of use.");
