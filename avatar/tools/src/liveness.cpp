@@ -98,13 +98,43 @@ class TrueMeshes {
   std::map<std::filesystem::path, nlohmann::json> takes_;
 };
 
-// Sums of per-frame mean squared distances (m²) of one split's frames.
-struct SquaredErrors {
-  double mesh = 0, corrected = 0;
-  std::optional<double> undone() const {
-    if (mesh <= 0) return std::nullopt;
-    return 1.0 - std::sqrt(corrected / mesh);
+// One split's errors against the truth: the whole error as sums of per-frame
+// mean squared distances (m²), and each Gaussian's error vectors (head space)
+// summed over frames, whose mean the frame-to-frame part leaves out.
+class SplitErrors {
+ public:
+  void add(const at::Tensor& mesh_error, const std::optional<at::Tensor>& corrected_error) {
+    ++frames_;
+    mesh_.add(mesh_error);
+    if (corrected_error) corrected_.add(*corrected_error);
   }
+  std::optional<double> undone() const { return share_undone(mesh_.squares, corrected_.squares); }
+  std::optional<double> varying_mm() const {
+    if (frames_ < 2) return std::nullopt;
+    return 1000.0 * std::sqrt(mesh_.varying(frames_) / frames_);
+  }
+  std::optional<double> varying_undone() const {
+    if (frames_ < 2 || !corrected_.sum.defined()) return std::nullopt;
+    return share_undone(mesh_.varying(frames_), corrected_.varying(frames_));
+  }
+
+ private:
+  struct Sums {
+    double squares = 0;  // Σ over frames of the mean over Gaussians of |e|²
+    at::Tensor sum;      // [N,3] double: Σ over frames of e
+    void add(const at::Tensor& e) {
+      squares += e.pow(2).sum(1).mean().item<double>();
+      sum = sum.defined() ? sum + e : e;
+    }
+    // Σ over frames of the mean over Gaussians of |e - ē|².
+    double varying(int frames) const { return squares - (sum / frames).pow(2).sum(1).mean().item<double>() * frames; }
+  };
+  static std::optional<double> share_undone(double error, double corrected) {
+    if (error <= 1e-18) return std::nullopt;
+    return 1.0 - std::sqrt(std::max(corrected, 0.0) / error);
+  }
+  int frames_ = 0;
+  Sums mesh_, corrected_;
 };
 
 // The network part a parameter belongs to, by its registered path.
@@ -189,7 +219,7 @@ Liveness inspect_avatar(trainer::TrainedAvatar& avatar, const Dataset& dataset, 
   std::optional<TrueMeshes> truth;
   if (!options.truth.empty()) truth.emplace(options.truth);
   const std::set<std::string> held_out(dataset.test.frames.begin(), dataset.test.frames.end());
-  SquaredErrors train_errors, test_errors;
+  SplitErrors train_errors, test_errors;
   {
     at::NoGradGuard no_grad;
     for (const DatasetFrame& f : dataset.frames) {
@@ -203,15 +233,15 @@ Liveness inspect_avatar(trainer::TrainedAvatar& avatar, const Dataset& dataset, 
       if (truth) {
         const auto [true_vertices, true_pose] = truth->frame(f, dataset.template_mesh.num_vertices());
         const at::Tensor target = model.pose(model.frame_input(true_vertices, true_pose), without_field).means;
-        const double mesh = (placed - target).pow(2).sum(1).mean().item<double>();
-        SquaredErrors& split = held_out.count(f.id) ? test_errors : train_errors;
-        split.mesh += mesh;
-        frame.mesh_error_mm = 1000.0 * std::sqrt(mesh);
-        if (out.deformation) {
-          const double corrected = (deformed - target).pow(2).sum(1).mean().item<double>();
-          split.corrected += corrected;
-          frame.corrected_error_mm = 1000.0 * std::sqrt(corrected);
-        }
+        // Row vectors to head space: (world - t) R.
+        Eigen::Matrix<double, 3, 3, Eigen::RowMajor> rotation = f.head_to_world.R;
+        const at::Tensor to_head = at::from_blob(rotation.data(), {3, 3}, at::kDouble).clone().to(placed.device());
+        const at::Tensor mesh = (placed - target).to(at::kDouble).matmul(to_head);
+        std::optional<at::Tensor> corrected;
+        if (out.deformation) corrected = (deformed - target).to(at::kDouble).matmul(to_head);
+        (held_out.count(f.id) ? test_errors : train_errors).add(mesh, corrected);
+        frame.mesh_error_mm = 1000.0 * std::sqrt(mesh.pow(2).sum(1).mean().item<double>());
+        if (corrected) frame.corrected_error_mm = 1000.0 * std::sqrt(corrected->pow(2).sum(1).mean().item<double>());
       }
       if (out.deformation) {
         const at::Tensor moved = (deformed - placed).norm(2, 1) * 1000.0;
@@ -233,9 +263,15 @@ Liveness inspect_avatar(trainer::TrainedAvatar& avatar, const Dataset& dataset, 
       out.frames.push_back(frame);
     }
     out.deformation_expression_r = out.deformation ? pearson(expression, deformation) : std::nan("");
+    if (truth) {
+      out.varying_error_mm_train = train_errors.varying_mm();
+      out.varying_error_mm_test = test_errors.varying_mm();
+    }
     if (truth && out.deformation) {
       out.error_undone_train = train_errors.undone();
       out.error_undone_test = test_errors.undone();
+      out.varying_error_undone_train = train_errors.varying_undone();
+      out.varying_error_undone_test = test_errors.varying_undone();
     }
     out.shading_expression_r = out.shading ? pearson(expression, shading_change) : std::nan("");
     if (shading_sum.defined()) {
@@ -269,7 +305,9 @@ std::string fixed(double v, int digits) {
   if (!std::isfinite(v)) return "n/a";
   char text[64];
   std::snprintf(text, sizeof(text), "%.*f", digits, v);
-  return text;
+  const std::string out = text;
+  // A value that rounds to zero prints without a sign.
+  return out[0] == '-' && out.find_first_not_of("-0.") == std::string::npos ? out.substr(1) : out;
 }
 
 std::string scientific(double v) {
@@ -306,6 +344,10 @@ nlohmann::json liveness_json(const Liveness& l) {
           {"off_birth_triangle", optional_number(l.off_birth_triangle)},
           {"error_undone_train", optional_number(l.error_undone_train)},
           {"error_undone_test", optional_number(l.error_undone_test)},
+          {"varying_error_mm_train", optional_number(l.varying_error_mm_train)},
+          {"varying_error_mm_test", optional_number(l.varying_error_mm_test)},
+          {"varying_error_undone_train", optional_number(l.varying_error_undone_train)},
+          {"varying_error_undone_test", optional_number(l.varying_error_undone_test)},
           {"gradient_norms", gradients},
           {"frames", frames}};
 }
@@ -341,6 +383,20 @@ std::string liveness_markdown(const Liveness& l, const std::string& name) {
       if (l.error_undone_test) out += " " + fixed(100.0 * *l.error_undone_test, 1) + " % on held-out frames";
     }
     out += "\n";
+    if (l.varying_error_mm_train || l.varying_error_mm_test) {
+      out += "- its frame-to-frame part (each Gaussian's mean error over the split's frames removed; the rest the "
+             "canonical Gaussians can absorb):";
+      const auto split = [&](const std::optional<double>& mm, const std::optional<double>& undone, const char* name) {
+        if (!mm) return std::string();
+        std::string text = " " + fixed(*mm, 3) + " mm on " + name + " frames";
+        if (undone) text += ", " + fixed(100.0 * *undone, 1) + " % of it undone";
+        return text;
+      };
+      out += split(l.varying_error_mm_train, l.varying_error_undone_train, "training");
+      if (l.varying_error_mm_train && l.varying_error_mm_test) out += ";";
+      out += split(l.varying_error_mm_test, l.varying_error_undone_test, "held-out");
+      out += "\n";
+    }
   }
   out += "- mean gradient norm of L1 + D-SSIM per part:";
   for (const auto& g : l.gradients) out += " " + g.part + " " + scientific(g.mean_norm) + ";";

@@ -2,7 +2,8 @@
 // moves and shades Gaussians and every part gets a gradient; a field whose
 // output layer is zero moves nothing; parts switched off are reported off;
 // Gaussians off their birth triangle are counted; against a virtual-studio
-// ground truth, the share of the meshes' error the field undoes.
+// ground truth, the share of the meshes' error the field undoes, all of it
+// and its frame-to-frame part.
 
 #include "tega/tools/liveness.h"
 
@@ -145,6 +146,36 @@ TEST(Liveness, AgainstTheTruthTheShareOfTheMeshErrorTheFieldUndoes) {
   EXPECT_NEAR(*off.frames[1].mesh_error_mm, 4.0, 1e-3);
   EXPECT_FALSE(off.frames[1].corrected_error_mm.has_value());
   EXPECT_FALSE(off.error_undone_train.has_value());
+}
+
+// Both frames in training, their true meshes 2 and 4 mm along x of the
+// dataset's: 3 mm common to the frames, ±1 mm from frame to frame. A constant
+// field of 3 mm undoes the common part and none of the frame-to-frame one.
+TEST(Liveness, AConstantFieldUndoesNoneOfTheFrameToFramePartOfTheError) {
+  test::TinyAvatar tiny;
+  tiny.dataset.train.frames = {"smile_000000", "blink_000000"};
+  tiny.dataset.test.frames.clear();
+  set_constant_field(tiny.model(), {0.003f, 0, 0});
+  write_shifted_truth(tiny.tmp / "capture", tiny.dataset,
+                      {{"smile_000000", {0.002f, 0, 0}}, {"blink_000000", {0.004f, 0, 0}}});
+  LivenessOptions options;
+  options.truth = tiny.tmp / "capture";
+  const Liveness l = inspect_avatar(*tiny.avatar, tiny.dataset, options);
+  ASSERT_TRUE(l.error_undone_train && l.varying_error_mm_train && l.varying_error_undone_train);
+  EXPECT_NEAR(*l.error_undone_train, 1.0 - 1.0 / std::sqrt(10.0), 1e-3);  // √10 mm RMS down to 1 mm
+  EXPECT_NEAR(*l.varying_error_mm_train, 1.0, 1e-3);
+  EXPECT_NEAR(*l.varying_error_undone_train, 0.0, 1e-3);
+  EXPECT_FALSE(l.varying_error_mm_test.has_value());  // no held-out frames
+  const std::string text = liveness_markdown(l, "varying");
+  EXPECT_NE(text.find("frame-to-frame part"), std::string::npos) << text;
+  EXPECT_NE(text.find("1.000 mm on training frames, 0.0 % of it undone"), std::string::npos) << text;
+  EXPECT_NEAR(liveness_json(l).at("varying_error_mm_train").get<double>(), 1.0, 1e-3);
+
+  // Without the field the frame-to-frame part is still measured, with no share undone.
+  tiny.avatar->phase.deformation = false;
+  const Liveness off = inspect_avatar(*tiny.avatar, tiny.dataset, options);
+  EXPECT_NEAR(*off.varying_error_mm_train, 1.0, 1e-3);
+  EXPECT_FALSE(off.varying_error_undone_train.has_value());
 }
 
 TEST(Liveness, ATruthThatIsNoVirtualStudioCaptureIsNamed) {

@@ -15,7 +15,9 @@
 //   the mesh's error (§3.4)   with a virtual-studio capture's ground truth:
 //                             how far the dataset's meshes put each Gaussian
 //                             from where the true meshes would, and how much
-//                             of that the deformation field undoes
+//                             of that the deformation field undoes: all of it,
+//                             and its frame-to-frame part, which the canonical
+//                             Gaussians cannot absorb
 //   gradients                 the mean L2 norm of the photometric loss's
 //                             gradient (L1 + D-SSIM, the run's weights) that
 //                             each part receives, over training views
@@ -72,6 +74,14 @@ struct Liveness {
   // split's frames and Gaussians) on training and held-out frames, the share
   // of the meshes' error the field undoes (1 all, 0 none, < 0 it adds error).
   std::optional<double> error_undone_train, error_undone_test;
+  // The same for the error's frame-to-frame part: each Gaussian's error
+  // vector (head space) less its mean over the split's frames. What is common
+  // to a split's frames the canonical Gaussians can absorb; this part only the
+  // field can undo. Its RMS (mm, without the field) and the share undone;
+  // absent below two frames in a split (or without a truth; the share also
+  // with the field off).
+  std::optional<double> varying_error_mm_train, varying_error_mm_test;
+  std::optional<double> varying_error_undone_train, varying_error_undone_test;
   std::vector<PartGradient> gradients;
 };
 
