@@ -7,8 +7,10 @@
 
 namespace tega::test {
 
-CommandResult run_tega(const std::string& arguments) {
-  const std::string command = std::string(TEGA_EXECUTABLE) + " " + arguments + " 2>&1";
+CommandResult run_tega(const std::string& arguments) { return run_command(std::string(TEGA_EXECUTABLE) + " " + arguments); }
+
+CommandResult run_command(const std::string& command_line) {
+  const std::string command = "(" + command_line + ") 2>&1";
   CommandResult result;
   FILE* pipe = ::popen(command.c_str(), "r");
   if (!pipe) return result;

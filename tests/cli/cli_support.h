@@ -10,6 +10,8 @@ struct CommandResult {
   std::string output;  // stdout and stderr together
 };
 
+// `command` run by the shell.
+CommandResult run_command(const std::string& command);
 // `arguments` is appended to the tega executable's path and run by the shell.
 CommandResult run_tega(const std::string& arguments);
 

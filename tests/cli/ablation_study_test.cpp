@@ -1,0 +1,86 @@
+// scripts/ablation-study end to end on a tiny CPU study: a capture of the
+// procedural head, two of the paper's rows and one row of the user's own
+// (ROWS_FILE), two seeds, a curve of two points (so every run resumes once), the
+// table over seeds and the liveness of each row against the true meshes.
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <set>
+#include <string>
+
+#include "cli_support.h"
+#include "tega/core/files.h"
+#include "test_support.h"
+
+namespace tega::test {
+namespace {
+
+const std::string kScript = std::string(TEGA_SOURCE_DIR) + "/scripts/ablation-study";
+
+// The environment of a study of the procedural head at 96x64, 12 iterations.
+std::string tiny_study_environment(const TempDir& tmp) {
+  write_text(tmp / "train.yaml",
+             "device: cpu\ncpu_threads: 2\ninitial_gaussians: 400\nlog_every: 4\ncheckpoint_every: 100000\n"
+             "network: {texture_size: 16, unet_widths: [4, 8], latent_channels: 4, mlp_hidden: 8}\n"
+             "uv_lookup: {resolution: 64}\n");
+  return "TEGA=" + std::string(TEGA_EXECUTABLE) + " HEAD=procedural WIDTH=96 HEIGHT=64 FRAMES=3 ITERATIONS=12 " +
+         "CURVE='0.5 1' SEEDS='0 1' PARALLEL=2 TRAIN_CONFIG=" + (tmp / "train.yaml").string() +
+         " SYNTH_SET=self_shadowing.map_size=256 ";
+}
+
+bool tega_trains() { return run_tega("train --help").exit_code == 0; }
+
+TEST(AblationStudy, TrainsEveryRowAndSeedThenTabulatesAndInspectsThem) {
+  if (!tega_trains()) GTEST_SKIP() << "this tega has no train command (no libtorch)";
+  TempDir tmp;
+  write_text(tmp / "rows", "# a row of the user's own\npyramid --set loss.pyramid_l1=1 --set loss.pyramid_levels=2\n");
+  const auto r = run_command(tiny_study_environment(tmp) + "VARIANTS='full gaussian-avatars' ROWS_FILE=" +
+                             (tmp / "rows").string() + " bash " + kScript + " " + (tmp / "study").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+
+  const nlohmann::json eval = nlohmann::json::parse(read_text_file(tmp / "study/eval.json"));
+  std::set<std::string> names;
+  for (const auto& model : eval.at("models")) names.insert(model.at("name").get<std::string>());
+  EXPECT_EQ(names, (std::set<std::string>{"full.s0", "full.s1", "gaussian-avatars.s0", "gaussian-avatars.s1",
+                                          "pyramid.s0", "pyramid.s1"}));
+  EXPECT_TRUE(std::filesystem::exists(tmp / "study/table-6.md"));  // the curve's first point
+
+  const std::string table = read_text_file(tmp / "study/table.md");
+  EXPECT_NE(table.find("(iteration 12)"), std::string::npos) << table;
+  EXPECT_NE(table.find("Seeds 0, 1."), std::string::npos) << table;
+  for (const char* row : {"| full |", "| gaussian-avatars |", "| pyramid |"})
+    EXPECT_NE(table.find(row), std::string::npos) << row << "\n" << table;
+
+  // The row's flags reached its runs, and only its runs.
+  EXPECT_NE(read_text_file(tmp / "study/runs/pyramid.s1/options.yaml").find("pyramid_l1: 1"), std::string::npos);
+  EXPECT_NE(read_text_file(tmp / "study/runs/full.s1/options.yaml").find("pyramid_l1: 0"), std::string::npos);
+
+  const std::string liveness = read_text_file(tmp / "study/liveness.md");
+  for (const char* run : {"## full.s0", "## gaussian-avatars.s0", "## pyramid.s0"})
+    EXPECT_NE(liveness.find(run), std::string::npos) << run << "\n" << liveness;
+  EXPECT_NE(liveness.find("against the true meshes"), std::string::npos) << liveness;
+}
+
+TEST(AblationStudy, ARowOfTheRowsFileMustBeNewAndWellNamed) {
+  TempDir tmp;
+  const std::string study = "VARIANTS='full' bash " + kScript + " " + (tmp / "study").string();
+  write_text(tmp / "again", "full --set loss.pyramid_l1=1\n");
+  auto r = run_command("ROWS_FILE=" + (tmp / "again").string() + " " + study);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("row 'full' is also in VARIANTS"), std::string::npos) << r.output;
+
+  write_text(tmp / "badly", "Pyramid.s0 --set loss.pyramid_l1=1\n");
+  r = run_command("ROWS_FILE=" + (tmp / "badly").string() + " " + study);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("row name 'Pyramid.s0' must be lower-case"), std::string::npos) << r.output;
+
+  r = run_command("ROWS_FILE=" + (tmp / "nowhere").string() + " " + study);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("ROWS_FILE: no file"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(tmp / "study/capture"));  // refused before any work
+}
+
+}  // namespace
+}  // namespace tega::test
