@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <yaml-cpp/yaml.h>
+
 #include <filesystem>
+#include <string>
 
 #include "tega/core/options.h"
 #include "tega/synth/options.h"
@@ -12,11 +15,24 @@ namespace {
 // Not through __FILE__: ccache's base_dir makes it relative to the build folder.
 const std::filesystem::path kStudio13 = std::filesystem::path(TEGA_STUDIO_CONFIGS) / "studio13.yaml";
 
+// Every key of `defaults` (recursively) is in `file`.
+void expect_every_key(const YAML::Node& file, const YAML::Node& defaults, const std::string& path) {
+  for (const auto& item : defaults) {
+    const std::string key = path + item.first.as<std::string>();
+    const YAML::Node found = file[item.first.as<std::string>()];
+    EXPECT_TRUE(found.IsDefined()) << "studio13.yaml lacks " << key;
+    if (found.IsDefined() && item.second.IsMap()) expect_every_key(found, item.second, key + ".");
+  }
+}
+
+// The file is the documented list of synth's options: equal to the defaults,
+// and complete (a key it lacks would take its default unseen).
 TEST(StudioRig, Studio13ConfigEqualsTheDefaults) {
   Options from_file;
   from_file.studio.cameras = 1;  // must be overwritten by the file
   load_options(from_file, kStudio13);
   EXPECT_EQ(options_to_yaml(from_file), options_to_yaml(Options{}));
+  expect_every_key(YAML::LoadFile(kStudio13.string()), YAML::Load(options_to_yaml(Options{})), "");
 }
 
 TEST(StudioRig, CamerasSurroundTheFrontAtTheirDistanceAimedAtTheHead) {
