@@ -1,10 +1,10 @@
 #pragma once
-// A training step's loss, MSE, all-finite flag and largest deformation, read by the host without
-// draining the GPU. On CUDA they are copied into pinned memory behind the
-// step's work and read one step later, when the copy has long completed
-// (the next step's rasterizer waits for the GPU once anyway); reading them
-// at once made every step wait for the GPU to finish before the next step
-// could be queued. On the CPU they are plain values.
+// A training step's loss, MSE, all-finite flag and largest deformation, read
+// by the host without draining the GPU. On CUDA they are copied into pinned
+// memory behind the step's work and read one step later, when the copy has
+// long completed (the next step's rasterizer waits for the GPU once anyway);
+// reading them at once made every step wait for the GPU to finish before the
+// next step could be queued. On the CPU they are plain values.
 
 #include <ATen/core/Tensor.h>
 #include <c10/core/Event.h>

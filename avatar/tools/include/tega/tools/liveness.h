@@ -78,8 +78,8 @@ struct Liveness {
   // vector (head space) less its mean over the split's frames. What is common
   // to a split's frames the canonical Gaussians can absorb; this part only the
   // field can undo. Its RMS (mm, without the field) and the share undone;
-  // absent below two frames in a split (or without a truth; the share also
-  // with the field off).
+  // absent without a truth or below two frames in the split, and the share
+  // also with the field off.
   std::optional<double> varying_error_mm_train, varying_error_mm_test;
   std::optional<double> varying_error_undone_train, varying_error_undone_test;
   std::vector<PartGradient> gradients;
