@@ -52,6 +52,9 @@ struct TinyAvatar {
     dataset = read_dataset(tmp / "data");
     dataset.eyeball_faces.clear();
     const trainer::TrainOptions options = tiny_network_options();
+    // The networks' initial weights come from libtorch's global generator,
+    // whose seed otherwise differs from process to process.
+    at::manual_seed(7);
     avatar = std::make_unique<trainer::TrainedAvatar>(
         trainer::TrainedAvatar{options, trainer::AvatarModel(dataset, options, at::kCPU), {true, true, 3}, 0});
     avatar->model.gaussians = random_gaussians(300);
