@@ -101,12 +101,19 @@ class TrueMeshes {
 // One split's errors against the truth: the whole error as sums of per-frame
 // mean squared distances (m²), and each Gaussian's error vectors (head space)
 // summed over frames, whose mean the frame-to-frame part leaves out.
+// A frame's mean over Gaussians of the squared error (m²), without and with the field.
+struct FrameSquares {
+  double mesh = 0;
+  std::optional<double> corrected;
+};
+
 class SplitErrors {
  public:
-  void add(const at::Tensor& mesh_error, const std::optional<at::Tensor>& corrected_error) {
+  FrameSquares add(const at::Tensor& mesh_error, const std::optional<at::Tensor>& corrected_error) {
     ++frames_;
-    mesh_.add(mesh_error);
-    if (corrected_error) corrected_.add(*corrected_error);
+    FrameSquares out{mesh_.add(mesh_error), std::nullopt};
+    if (corrected_error) out.corrected = corrected_.add(*corrected_error);
+    return out;
   }
   std::optional<double> undone() const { return share_undone(mesh_.squares, corrected_.squares); }
   std::optional<double> varying_mm() const {
@@ -122,9 +129,11 @@ class SplitErrors {
   struct Sums {
     double squares = 0;  // Σ over frames of the mean over Gaussians of |e|²
     at::Tensor sum;      // [N,3] double: Σ over frames of e
-    void add(const at::Tensor& e) {
-      squares += e.pow(2).sum(1).mean().item<double>();
+    double add(const at::Tensor& e) {  // returns the frame's mean over Gaussians of |e|²
+      const double frame = e.pow(2).sum(1).mean().item<double>();
+      squares += frame;
       sum = sum.defined() ? sum + e : e;
+      return frame;
     }
     // Σ over frames of the mean over Gaussians of |e - ē|².
     double varying(int frames) const { return squares - (sum / frames).pow(2).sum(1).mean().item<double>() * frames; }
@@ -234,14 +243,13 @@ Liveness inspect_avatar(trainer::TrainedAvatar& avatar, const Dataset& dataset, 
         const auto [true_vertices, true_pose] = truth->frame(f, dataset.template_mesh.num_vertices());
         const at::Tensor target = model.pose(model.frame_input(true_vertices, true_pose), without_field).means;
         // Row vectors to head space: (world - t) R.
-        Eigen::Matrix<double, 3, 3, Eigen::RowMajor> rotation = f.head_to_world.R;
-        const at::Tensor to_head = at::from_blob(rotation.data(), {3, 3}, at::kDouble).clone().to(placed.device());
-        const at::Tensor mesh = (placed - target).to(at::kDouble).matmul(to_head);
+        const auto to_head = [&](const at::Tensor& error) { return error.matmul(input.head_rotation).to(at::kDouble); };
         std::optional<at::Tensor> corrected;
-        if (out.deformation) corrected = (deformed - target).to(at::kDouble).matmul(to_head);
-        (held_out.count(f.id) ? test_errors : train_errors).add(mesh, corrected);
-        frame.mesh_error_mm = 1000.0 * std::sqrt(mesh.pow(2).sum(1).mean().item<double>());
-        if (corrected) frame.corrected_error_mm = 1000.0 * std::sqrt(corrected->pow(2).sum(1).mean().item<double>());
+        if (out.deformation) corrected = to_head(deformed - target);
+        SplitErrors& split = held_out.count(f.id) ? test_errors : train_errors;
+        const FrameSquares squares = split.add(to_head(placed - target), corrected);
+        frame.mesh_error_mm = 1000.0 * std::sqrt(squares.mesh);
+        if (squares.corrected) frame.corrected_error_mm = 1000.0 * std::sqrt(*squares.corrected);
       }
       if (out.deformation) {
         const at::Tensor moved = (deformed - placed).norm(2, 1) * 1000.0;
