@@ -87,7 +87,7 @@ void render_performance(const Studio& studio, const std::string& take, const Dat
         write_vertices_bin(g.coarse, dataset.mesh_path(id));
         return;
       }
-      // The dataset's mesh as a tracker would have it: lagged, misfit, offset.
+      // The dataset's mesh as a tracker would have it: lagged, misfit, its model's shapes, offset.
       const TrackingError::LagSource lag = errors.lag_source(f, o.frames);
       std::vector<float> lagged = script_expression(lag.first);
       if (lag.weight > 0) {
@@ -100,10 +100,19 @@ void render_performance(const Studio& studio, const std::string& take, const Dat
         g.dataset_pose = interpolate_pose(script[lag.first].motion, script[lag.second].motion, lag.weight) *
                          pivot_to_origin;
       Vertices mesh = model.evaluate({}, expression, g.dataset_pose);
+      const auto add_head_space = [&](const Vertices& d) {
+        mesh += (d.cast<double>() * g.dataset_pose.R.transpose()).cast<float>();
+      };
+      double shape_rms = 0;
+      if (errors.options().shape_misfit > 0) {
+        const Vertices shape = errors.shape_error(expression);
+        add_head_space(shape);
+        shape_rms = errors.skin_rms(shape);
+      }
       double rms = 0, largest = 0;
       if (errors.options().offset_m > 0) {
-        const Vertices offset = errors.offset(take, f);  // head space
-        mesh += (offset.cast<double>() * g.dataset_pose.R.transpose()).cast<float>();
+        const Vertices offset = errors.offset(take, f);
+        add_head_space(offset);
         rms = errors.skin_rms(offset);
         largest = errors.skin_max(offset);
       }
@@ -118,7 +127,8 @@ void render_performance(const Studio& studio, const std::string& take, const Dat
                           {"expression", coefficients},
                           {"head_to_world", pose_json(g.dataset_pose)},
                           {"offset_rms_m", rms},     // over the skin (non-eyeball) vertices
-                          {"offset_max_m", largest}};
+                          {"offset_max_m", largest},
+                          {"shape_misfit_rms_m", shape_rms}};  // likewise
     });
 
     studio.pool.parallel_for(0, int64_t(count) * n_cameras, [&](int64_t task) {

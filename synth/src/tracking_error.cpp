@@ -12,7 +12,7 @@ namespace tega::synth {
 namespace {
 
 // Salts that keep each error's draws apart from every other use of the seed.
-constexpr uint64_t kOffsetSalt = 0x7e0ff5e7, kMisfitSalt = 0x7e3157f1;
+constexpr uint64_t kOffsetSalt = 0x7e0ff5e7, kMisfitSalt = 0x7e3157f1, kShapeSalt = 0x75a9e3f1;
 
 bool starts_with(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
 
@@ -27,6 +27,7 @@ void validate_tracking_error_options(const TrackingErrorOptions& o) {
   if (o.eyelid_misfit < 0 || o.lip_misfit < 0)
     throw Error("tracking_error.eyelid_misfit and lip_misfit must not be negative");
   if (o.eyelid_gain < 0 || o.lip_gain < 0) throw Error("tracking_error.eyelid_gain and lip_gain must not be negative");
+  if (o.shape_misfit < 0) throw Error("tracking_error.shape_misfit must not be negative");
 }
 
 TrackingError::TrackingError(const Head& head, const TrackingErrorOptions& options, uint64_t seed)
@@ -52,6 +53,15 @@ TrackingError::TrackingError(const Head& head, const TrackingErrorOptions& optio
   is_lip_.assign(model.expression_names.size(), 0);
   for (size_t e = 0; e < model.expression_names.size(); ++e)
     is_lip_[e] = starts_with(model.expression_names[e], "jaw") || starts_with(model.expression_names[e], "mouth");
+  // Drawn per subject and expression, not per take or frame: the tracker's
+  // model is the same in every frame.
+  if (options_.shape_misfit > 0)
+    for (const std::string& name : model.expression_names) {
+      Eigen::VectorXd gain = smooth_draw(hash_of(seed_, kShapeSalt, hash_string(name.c_str())), 0, 1).col(0);
+      for (int v = 0; v < model.num_vertices(); ++v)
+        if (vertex_eye_[v]) gain[v] = 0;
+      shape_gains_.push_back(std::move(gain));
+    }
 }
 
 void TrackingError::keys(int frame, int& key, double& weight) const {
@@ -95,44 +105,47 @@ std::vector<float> TrackingError::misfit(const std::vector<float>& expression, c
   return out;
 }
 
-Eigen::MatrixXd TrackingError::offset_draw(uint64_t take_seed, int key) const {
+Eigen::MatrixXd TrackingError::smooth_draw(uint64_t seed, int key, int components) const {
   const Mesh& neutral = head_.model.neutral;
   const FaceFrame& frame = head_.frame;
   const int n = head_.model.num_vertices();
   struct Bump {
-    Eigen::Vector3d centre, direction;
+    Eigen::Vector3d centre;
+    Eigen::VectorXd amplitude;
   };
-  std::vector<Bump> bumps;
+  std::vector<Bump> bumps(options_.offset_bumps);
   for (int b = 0; b < options_.offset_bumps; ++b) {
-    const auto u = [&](int k) { return uniform(take_seed, key, b, k); };
-    Bump bump;
-    for (int k = 0; k < 3; ++k) {
-      bump.centre[k] = box_min_[k] + u(k) * (box_max_[k] - box_min_[k]);
-      bump.direction[k] = gaussian(take_seed, key, b, 3 + k);
-    }
-    bumps.push_back(bump);
+    for (int k = 0; k < 3; ++k)
+      bumps[b].centre[k] = box_min_[k] + uniform(seed, key, b, k) * (box_max_[k] - box_min_[k]);
+    bumps[b].amplitude.resize(components);
+    for (int k = 0; k < components; ++k) bumps[b].amplitude[k] = gaussian(seed, key, b, 3 + k);
   }
   const double inv_two_sigma2 = 1.0 / (2 * options_.offset_scale * options_.offset_scale);
-  // In face-frame axes; an eyeball takes the field at its centre (it moves rigidly).
   const auto field = [&](const Eigen::Vector3d& p) {
-    Eigen::Vector3d d = Eigen::Vector3d::Zero();
-    for (const Bump& b : bumps) d += b.direction * std::exp(-(p - b.centre).squaredNorm() * inv_two_sigma2);
-    return d;
+    Eigen::VectorXd value = Eigen::VectorXd::Zero(components);
+    for (const Bump& b : bumps) value += b.amplitude * std::exp(-(p - b.centre).squaredNorm() * inv_two_sigma2);
+    return value;
   };
-  const Eigen::Vector3d eye[3] = {Eigen::Vector3d::Zero(), field(frame.to_face(frame.eye_left)),
+  const Eigen::VectorXd eye[3] = {Eigen::VectorXd::Zero(components), field(frame.to_face(frame.eye_left)),
                                   field(frame.to_face(frame.eye_right))};
-  Eigen::MatrixXd d(n, 3);
+  Eigen::MatrixXd d(n, components);
   double sum2 = 0;
   int skin = 0;
   for (int v = 0; v < n; ++v) {
     const int e = vertex_eye_[v];
-    const Eigen::Vector3d f = e ? eye[e] : field(frame.to_face(neutral.positions.row(v).cast<double>().transpose()));
-    d.row(v) = (frame.axes * f).transpose();  // face-frame axes to head space
-    if (!e) sum2 += f.squaredNorm(), ++skin;
+    const Eigen::VectorXd value =
+        e ? eye[e] : field(frame.to_face(neutral.positions.row(v).cast<double>().transpose()));
+    d.row(v) = value.transpose();
+    if (!e) sum2 += value.squaredNorm(), ++skin;
   }
   const double rms = skin ? std::sqrt(sum2 / skin) : 0.0;
   if (rms > 0) d /= rms;
   return d;
+}
+
+Eigen::MatrixXd TrackingError::offset_draw(uint64_t take_seed, int key) const {
+  // Face-frame axes to head space (a rotation: the RMS stays 1).
+  return smooth_draw(take_seed, key, 3) * head_.frame.axes.transpose();
 }
 
 Vertices TrackingError::offset(const std::string& take, int frame) const {
@@ -151,6 +164,16 @@ Vertices TrackingError::offset(const std::string& take, int frame) const {
   const double rms = skin ? std::sqrt(sum2 / skin) : 0.0;
   if (rms > 0) d *= options_.offset_m / rms;
   return d.cast<float>();
+}
+
+Vertices TrackingError::shape_error(const std::vector<float>& expression) const {
+  const BlendshapeModel& model = head_.model;
+  Eigen::MatrixXd error = Eigen::MatrixXd::Zero(model.num_vertices(), 3);
+  for (size_t e = 0; e < shape_gains_.size() && e < expression.size(); ++e)
+    if (expression[e] != 0)
+      error += (options_.shape_misfit * expression[e]) * shape_gains_[e].asDiagonal() *
+               model.expression_deltas[e].cast<double>();
+  return error.cast<float>();
 }
 
 double TrackingError::skin_rms(const Vertices& offset) const {

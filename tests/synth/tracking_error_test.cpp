@@ -16,6 +16,7 @@
 #include "tega/core/dataset.h"
 #include "tega/core/error.h"
 #include "tega/core/mesh.h"
+#include "tega/synth/tracking_error.h"
 #include "tega/synth/virtual_studio.h"
 #include "test_support.h"
 
@@ -252,6 +253,82 @@ TEST(TrackingError, LipMisfitMovesOnlyWhatTheJawAndMouthShapesMove) {
   EXPECT_GT(differ, 0);
 }
 
+// The shape misfit in the dataset's meshes is the tracker's model error for
+// the frame's own expression: each shape's motion scaled along itself by a
+// smooth gain, the same for the same expression in every frame and take.
+TEST(TrackingError, ShapeMisfitScalesEachShapesMotionByASmoothGainFixedPerExpression) {
+  Options o = tiny_capture();
+  o.tracking_error.shape_misfit = 0.3;
+  const RenderedCapture r(o);
+  const Head head = make_head(o);
+  const BlendshapeModel& model = head.model;
+  const std::vector<char> eye = eyeball_vertices(head);
+  const TrackingError errors(head, o.tracking_error, uint64_t(o.seed));
+
+  // In the capture: the mesh's error is the shape error of the true
+  // expression, rotated with the head, and the record says its size.
+  const nlohmann::json truth = read_json_file(r.dir / "ground_truth" / kTake / "frames.json");
+  const nlohmann::json record = read_json_file(r.dir / "dataset/tracking_error.json");
+  double largest = 0;
+  for (int f = 0; f < kFrames; ++f) {
+    std::vector<float> expression(model.expression_names.size(), 0.0f);
+    for (const auto& [name, value] : truth["frames"][f]["expression"].items())
+      expression[model.expression_index(name)] = value.get<float>();
+    const Vertices expected = errors.shape_error(expression);
+    const Eigen::MatrixXd d = (dataset_mesh(r.dir, f) - truth_mesh(r.dir, f)).cast<double>() * truth_pose(r.dir, f).R;
+    EXPECT_LT((d - expected.cast<double>()).cwiseAbs().maxCoeff(), 1e-5) << "frame " << f;
+    EXPECT_NEAR(record["frames"][f]["shape_misfit_rms_m"].get<double>(), errors.skin_rms(expected), 1e-9);
+    largest = std::max(largest, d.rowwise().norm().maxCoeff());
+  }
+  EXPECT_GT(largest, 1e-3) << "the expressions hardly move the face: the test shows nothing";
+
+  // One shape: its motion, scaled along itself, nothing where it does not
+  // move and on the eyeballs, linear in the coefficient.
+  const int jaw = model.expression_index("jawOpen");
+  ASSERT_GE(jaw, 0);
+  std::vector<float> open(model.expression_names.size(), 0.0f);
+  EXPECT_EQ(errors.shape_error(open).cwiseAbs().maxCoeff(), 0.0f);
+  open[jaw] = 1;
+  const Eigen::MatrixXd full = errors.shape_error(open).cast<double>();
+  open[jaw] = 0.5;
+  EXPECT_LT((errors.shape_error(open).cast<double>() - 0.5 * full).cwiseAbs().maxCoeff(), 1e-7);
+  const Eigen::MatrixXd delta = model.expression_deltas[jaw].cast<double>();
+  std::vector<double> gain(model.num_vertices(), 0.0);
+  for (int v = 0; v < model.num_vertices(); ++v) {
+    const Eigen::Vector3d e = full.row(v).transpose(), m = delta.row(v).transpose();
+    if (eye[v] || m.norm() == 0) {
+      EXPECT_EQ(e.norm(), 0.0) << "vertex " << v;
+      continue;
+    }
+    EXPECT_LE(e.cross(m).norm(), 1e-6 * e.norm() * m.norm()) << "vertex " << v << " is moved off its shape's direction";
+    if (m.norm() > 1e-4) gain[v] = e.dot(m) / (0.3 * m.squaredNorm());
+  }
+  // Smooth: across the skin's short edges the gain changes little against its spread.
+  double spread = 0, step = 0;
+  int moved = 0, edges = 0;
+  for (int v = 0; v < model.num_vertices(); ++v)
+    if (gain[v] != 0) spread += gain[v] * gain[v], ++moved;
+  const Triangles& faces = model.neutral.faces;
+  for (int t = 0; t < faces.rows(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const int a = faces(t, k), b = faces(t, (k + 1) % 3);
+      if (gain[a] == 0 || gain[b] == 0) continue;
+      if ((model.neutral.positions.row(a) - model.neutral.positions.row(b)).norm() > 0.01) continue;
+      step += std::abs(gain[a] - gain[b]), ++edges;
+    }
+  ASSERT_GT(moved, 10);
+  ASSERT_GT(edges, 10);
+  EXPECT_LT(step / edges, 0.1 * std::sqrt(spread / moved));
+
+  // Fixed per subject: the same for another instance with the seed, another
+  // field with another seed.
+  const TrackingError again(head, o.tracking_error, uint64_t(o.seed));
+  open[jaw] = 1;
+  EXPECT_EQ(again.shape_error(open), errors.shape_error(open));
+  const TrackingError other(head, o.tracking_error, uint64_t(o.seed) + 1);
+  EXPECT_GT((other.shape_error(open) - errors.shape_error(open)).cwiseAbs().maxCoeff(), 1e-4);
+}
+
 TEST(TrackingError, BadOptionsAreRefusedByName) {
   Options o = tiny_capture();
   o.tracking_error.offset_m = -0.001;
@@ -261,6 +338,9 @@ TEST(TrackingError, BadOptionsAreRefusedByName) {
   EXPECT_THROW(validate_options(o), Error);
   o = tiny_capture();
   o.tracking_error.period_frames = 0;
+  EXPECT_THROW(validate_options(o), Error);
+  o = tiny_capture();
+  o.tracking_error.shape_misfit = -0.1;
   EXPECT_THROW(validate_options(o), Error);
   EXPECT_NO_THROW(validate_options(tiny_capture()));
 }
@@ -275,6 +355,7 @@ TEST(TrackingError, ImagesAndTruthAreIdenticalWithAndWithoutErrorsWhichAreRecord
   o.tracking_error.eyelid_gain = 0.8;
   o.tracking_error.lip_misfit = 0.1;
   o.tracking_error.lip_gain = 0.9;
+  o.tracking_error.shape_misfit = 0.2;
   const RenderedCapture r(o);
   const fs::path& off = without_errors();
   int compared = 0, meshes_differ = 0;

@@ -46,7 +46,8 @@ struct StudioOptions {
 // head, so an avatar trained on the dataset meets the errors a real tracked
 // mesh has. Everything is off by default (the dataset's meshes are then the
 // true coarse meshes, byte for byte). Applied in this order: lag, misfit (to
-// the expression coefficients), then the offset field (to the mesh).
+// the expression coefficients), then the shape misfit and the offset field
+// (to the mesh).
 // docs/virtual-studio.md#tracking-errors says what each models.
 struct TrackingErrorOptions {
   double offset_m = 0.0;
@@ -59,11 +60,12 @@ struct TrackingErrorOptions {
   double eyelid_gain = 1.0;
   double lip_misfit = 0.0;
   double lip_gain = 1.0;
+  double shape_misfit = 0.0;
 
   // Whether any of the errors changes a mesh.
   bool enabled() const {
     return offset_m != 0 || lag != 0 || eyelid_misfit != 0 || eyelid_gain != 1 || lip_misfit != 0 ||
-           lip_gain != 1;
+           lip_gain != 1 || shape_misfit != 0;
   }
 
   template <class V>
@@ -100,6 +102,12 @@ struct TrackingErrorOptions {
     v("lip_gain", lip_gain,
       "Factor on the jaw* and mouth* expressions before the misfit error (1 = none; < 1: mouth shapes "
       "that the meshes under-state).");
+    v("shape_misfit", shape_misfit,
+      "Relative error of the tracker's expression shapes (0 = none): in the dataset's meshes each "
+      "expression shape moves skin vertex v by (1 + shape_misfit * g_e(v)) times what the subject's "
+      "face does, g_e a smooth random field like the offset field's (offset_bumps bumps of "
+      "offset_scale) with RMS 1 over the skin, drawn once per expression from the seed: the same "
+      "expression is wrong the same way in every frame and take. The eyeballs keep their motion.");
   }
 };
 

@@ -44,6 +44,11 @@ class TrackingError {
   // The offset field of a frame, head space, V x 3 (zero without offset_m):
   // its RMS over the skin (non-eyeball) vertices is offset_m.
   Vertices offset(const std::string& take, int frame) const;
+  // The shape misfit's displacement for these expression coefficients, head
+  // space, V x 3 (zero without shape_misfit): each expression shape's motion of
+  // a skin vertex scaled by shape_misfit times its gain field, summed with the
+  // coefficients as weights.
+  Vertices shape_error(const std::vector<float>& expression) const;
   // RMS and largest length of the offsets of the skin (non-eyeball) vertices.
   double skin_rms(const Vertices& offset) const;
   double skin_max(const Vertices& offset) const;
@@ -51,7 +56,12 @@ class TrackingError {
  private:
   // The frame's draws: key frames `key` and `key + 1` blended by `weight`.
   void keys(int frame, int& key, double& weight) const;
-  Eigen::MatrixXd offset_draw(uint64_t take_seed, int key) const;  // V x 3, RMS 1 over the skin
+  // A smooth random field of `components` values per vertex, face-frame
+  // components: options_.offset_bumps Gaussian bumps of options_.offset_scale
+  // centred in the skin's box, each with normal amplitudes; an eyeball's
+  // vertices take its value at the eyeball's centre. RMS 1 over the skin.
+  Eigen::MatrixXd smooth_draw(uint64_t seed, int key, int components) const;
+  Eigen::MatrixXd offset_draw(uint64_t take_seed, int key) const;  // V x 3 head space, RMS 1 over the skin
 
   const Head& head_;
   TrackingErrorOptions options_;
@@ -60,6 +70,7 @@ class TrackingError {
   Eigen::Vector3d box_min_, box_max_;  // the skin's neutral vertices, face frame
   int blink_left_ = -1, blink_right_ = -1;
   std::vector<char> is_lip_;  // per model expression: jaw* or mouth*
+  std::vector<Eigen::VectorXd> shape_gains_;  // per model expression: g_e per vertex (0 on eyeballs)
 };
 
 // Rigid transform between a (weight 0) and b (weight 1): rotations by slerp,
