@@ -49,7 +49,8 @@ class TrackingError {
   // a skin vertex scaled by shape_misfit times its gain field, summed with the
   // coefficients as weights.
   Vertices shape_error(const std::vector<float>& expression) const;
-  // RMS and largest length of the offsets of the skin (non-eyeball) vertices.
+  // RMS and largest length of a displacement (offset, shape error) over the
+  // skin (non-eyeball) vertices.
   double skin_rms(const Vertices& offset) const;
   double skin_max(const Vertices& offset) const;
 
