@@ -176,18 +176,18 @@ Vertices TrackingError::shape_error(const std::vector<float>& expression) const 
   return error.cast<float>();
 }
 
-double TrackingError::skin_rms(const Vertices& offset) const {
+double TrackingError::skin_rms(const Vertices& displacement) const {
   double sum2 = 0;
   int skin = 0;
-  for (int v = 0; v < offset.rows(); ++v)
-    if (!vertex_eye_[v]) sum2 += offset.row(v).cast<double>().squaredNorm(), ++skin;
+  for (int v = 0; v < displacement.rows(); ++v)
+    if (!vertex_eye_[v]) sum2 += displacement.row(v).cast<double>().squaredNorm(), ++skin;
   return skin ? std::sqrt(sum2 / skin) : 0.0;
 }
 
-double TrackingError::skin_max(const Vertices& offset) const {
+double TrackingError::skin_max(const Vertices& displacement) const {
   double largest = 0;
-  for (int v = 0; v < offset.rows(); ++v)
-    if (!vertex_eye_[v]) largest = std::max(largest, offset.row(v).cast<double>().norm());
+  for (int v = 0; v < displacement.rows(); ++v)
+    if (!vertex_eye_[v]) largest = std::max(largest, displacement.row(v).cast<double>().norm());
   return largest;
 }
 

@@ -51,8 +51,8 @@ class TrackingError {
   Vertices shape_error(const std::vector<float>& expression) const;
   // RMS and largest length of a displacement (offset, shape error) over the
   // skin (non-eyeball) vertices.
-  double skin_rms(const Vertices& offset) const;
-  double skin_max(const Vertices& offset) const;
+  double skin_rms(const Vertices& displacement) const;
+  double skin_max(const Vertices& displacement) const;
 
  private:
   // The frame's draws: key frames `key` and `key + 1` blended by `weight`.
