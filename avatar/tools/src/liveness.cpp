@@ -98,15 +98,15 @@ class TrueMeshes {
   std::map<std::filesystem::path, nlohmann::json> takes_;
 };
 
-// One split's errors against the truth: the whole error as sums of per-frame
-// mean squared distances (m²), and each Gaussian's error vectors (head space)
-// summed over frames, whose mean the frame-to-frame part leaves out.
 // A frame's mean over Gaussians of the squared error (m²), without and with the field.
 struct FrameSquares {
   double mesh = 0;
   std::optional<double> corrected;
 };
 
+// One split's errors against the truth: the whole error as sums of per-frame
+// mean squared distances (m²), and each Gaussian's error vectors (head space)
+// summed over frames, whose mean the frame-to-frame part leaves out.
 class SplitErrors {
  public:
   FrameSquares add(const at::Tensor& mesh_error, const std::optional<at::Tensor>& corrected_error) {
