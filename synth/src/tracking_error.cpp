@@ -129,16 +129,11 @@ Eigen::MatrixXd TrackingError::smooth_draw(uint64_t seed, int key, int component
   const Eigen::VectorXd eye[3] = {Eigen::VectorXd::Zero(components), field(frame.to_face(frame.eye_left)),
                                   field(frame.to_face(frame.eye_right))};
   Eigen::MatrixXd d(n, components);
-  double sum2 = 0;
-  int skin = 0;
   for (int v = 0; v < n; ++v) {
     const int e = vertex_eye_[v];
-    const Eigen::VectorXd value =
-        e ? eye[e] : field(frame.to_face(neutral.positions.row(v).cast<double>().transpose()));
-    d.row(v) = value.transpose();
-    if (!e) sum2 += value.squaredNorm(), ++skin;
+    d.row(v) = (e ? eye[e] : field(frame.to_face(neutral.positions.row(v).cast<double>().transpose()))).transpose();
   }
-  const double rms = skin ? std::sqrt(sum2 / skin) : 0.0;
+  const double rms = skin_rms_of_rows(d);
   if (rms > 0) d /= rms;
   return d;
 }
@@ -157,11 +152,7 @@ Vertices TrackingError::offset(const std::string& take, int frame) const {
   const uint64_t take_seed = hash_of(seed_, kOffsetSalt, hash_string(take.c_str()));
   Eigen::MatrixXd d = offset_draw(take_seed, key);
   if (weight > 0) d = (1 - weight) * d + weight * offset_draw(take_seed, key + 1);
-  double sum2 = 0;
-  int skin = 0;
-  for (int v = 0; v < n; ++v)
-    if (!vertex_eye_[v]) sum2 += d.row(v).squaredNorm(), ++skin;
-  const double rms = skin ? std::sqrt(sum2 / skin) : 0.0;
+  const double rms = skin_rms_of_rows(d);
   if (rms > 0) d *= options_.offset_m / rms;
   return d.cast<float>();
 }
@@ -176,12 +167,16 @@ Vertices TrackingError::shape_error(const std::vector<float>& expression) const 
   return error.cast<float>();
 }
 
-double TrackingError::skin_rms(const Vertices& displacement) const {
+double TrackingError::skin_rms_of_rows(const Eigen::MatrixXd& rows) const {
   double sum2 = 0;
   int skin = 0;
-  for (int v = 0; v < displacement.rows(); ++v)
-    if (!vertex_eye_[v]) sum2 += displacement.row(v).cast<double>().squaredNorm(), ++skin;
+  for (int v = 0; v < rows.rows(); ++v)
+    if (!vertex_eye_[v]) sum2 += rows.row(v).squaredNorm(), ++skin;
   return skin ? std::sqrt(sum2 / skin) : 0.0;
+}
+
+double TrackingError::skin_rms(const Vertices& displacement) const {
+  return skin_rms_of_rows(displacement.cast<double>());
 }
 
 double TrackingError::skin_max(const Vertices& displacement) const {

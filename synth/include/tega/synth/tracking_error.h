@@ -63,6 +63,7 @@ class TrackingError {
   // vertices take its value at the eyeball's centre. RMS 1 over the skin.
   Eigen::MatrixXd smooth_draw(uint64_t seed, int key, int components) const;
   Eigen::MatrixXd offset_draw(uint64_t take_seed, int key) const;  // V x 3 head space, RMS 1 over the skin
+  double skin_rms_of_rows(const Eigen::MatrixXd& rows) const;  // RMS of the skin vertices' row lengths
 
   const Head& head_;
   TrackingErrorOptions options_;
