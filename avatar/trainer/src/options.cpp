@@ -87,6 +87,16 @@ void validate_train_options(const TrainOptions& options) {
          << " and " << options.loss.pyramid_levels << ")";
     throw Error(what.str());
   }
+  const double smooth_initial = options.loss.smoothness_initial, smooth_final = options.loss.smoothness_final;
+  const bool smoothness_off = smooth_initial == 0 && smooth_final == 0;
+  if (!smoothness_off && !(smooth_initial > 0 && smooth_final > 0)) {
+    // The weight decays geometrically from one to the other, which needs both positive.
+    std::ostringstream what;
+    what << "loss.smoothness_initial and loss.smoothness_final must both be positive, or both 0 to turn the "
+            "smoothness term off (got "
+         << smooth_initial << " and " << smooth_final << ")";
+    throw Error(what.str());
+  }
   if (options.binding == "rigged" && (options.deformation_field || options.dynamic_shading)) {
     throw Error("binding: rigged (GaussianAvatars) has no UVD space for the networks: set deformation_field and "
                 "dynamic_shading to false (--baseline gaussian-avatars does)");

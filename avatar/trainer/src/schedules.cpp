@@ -18,6 +18,7 @@ double vgg_weight(const LossOptions& loss, int64_t iteration, int64_t iterations
 }
 
 double smoothness_weight(const LossOptions& loss, int64_t iteration, int64_t iterations) {
+  if (loss.smoothness_initial == 0) return 0.0;  // the term is off (validate_train_options: both are 0)
   const double t = static_cast<double>(iteration) / static_cast<double>(std::max<int64_t>(1, iterations / 2));
   return loss.smoothness_initial * std::pow(loss.smoothness_final / loss.smoothness_initial, std::min(t, 1.0));
 }

@@ -316,15 +316,15 @@ class Run {
   }
 
   // The weighted Jacobian smoothness loss on random uvd samples, or undefined
-  // when the field is off.
+  // when the field or the term is off.
   at::Tensor smoothness_term(const Phase& p, const PosedGaussians& posed) {
-    if (!p.deformation || options_.loss.smoothness_samples <= 0) return {};
+    const double weight = schedules::smoothness_weight(options_.loss, iteration_, options_.iterations);
+    if (!p.deformation || options_.loss.smoothness_samples <= 0 || weight == 0) return {};
     RECORD_FUNCTION("tega::smoothness", std::vector<c10::IValue>());
     const at::Tensor samples = to_device(
         nn::sample_smoothness_uvd(options_.loss.smoothness_samples, at::TensorOptions(at::kFloat), generator_));
     const at::Tensor jacobians = model_.network->deform(samples, posed.latents, true).jacobian;
-    return schedules::smoothness_weight(options_.loss, iteration_, options_.iterations) *
-           nn::jacobian_smoothness_loss(jacobians, nn::Reduction::mean);
+    return weight * nn::jacobian_smoothness_loss(jacobians, nn::Reduction::mean);
   }
 
   // GaussianAvatars' position and scale regularisers, in local units: they

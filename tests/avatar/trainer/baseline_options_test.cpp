@@ -71,5 +71,17 @@ TEST(BaselineOptions, APyramidTermNeedsAWeightOfZeroOrMoreAndALevel) {
   EXPECT_THROW(validate_train_options(o), Error);
 }
 
+TEST(BaselineOptions, TheSmoothnessWeightsAreBothPositiveOrBothZero) {
+  TrainOptions o;
+  o.loss.smoothness_initial = 0;
+  EXPECT_THROW(validate_train_options(o), Error);  // no geometric decay from 0 to 0.1
+  o.loss.smoothness_final = 0;
+  EXPECT_NO_THROW(validate_train_options(o));  // off
+  o.loss.smoothness_initial = 1;
+  EXPECT_THROW(validate_train_options(o), Error);
+  o.loss.smoothness_final = -0.1;
+  EXPECT_THROW(validate_train_options(o), Error);
+}
+
 }  // namespace
 }  // namespace tega::trainer

@@ -37,6 +37,15 @@ TEST(Schedules, SmoothnessWeightDecaysToATenthByHalfway) {
   EXPECT_DOUBLE_EQ(schedules::smoothness_weight(paper, 59999, kTotal), 0.1);
 }
 
+TEST(Schedules, SmoothnessWeightIsZeroThroughoutWhenTheTermIsOff) {
+  LossOptions off;
+  off.smoothness_initial = 0;
+  off.smoothness_final = 0;
+  for (const int64_t iteration : {0, 15000, 30000, 59999}) {
+    EXPECT_EQ(schedules::smoothness_weight(off, iteration, kTotal), 0.0) << iteration;
+  }
+}
+
 TEST(Schedules, ScaleWithTheIterationCount) {
   const LossOptions paper;
   EXPECT_DOUBLE_EQ(schedules::vgg_weight(paper, 300, 600), 0.01);

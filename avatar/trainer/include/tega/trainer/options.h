@@ -89,7 +89,7 @@ struct LossOptions {
       "Weight of L1 on the 2x, 4x, ... box-averaged images (mean over the levels): coarse gradients for "
       "misalignments wider than the skin's texture, a stand-in for the VGG term's (docs/networks-and-losses.md). 0 = off.");
     v("pyramid_levels", pyramid_levels, "Levels of the pyramid L1 term (the coarsest averages 2^levels pixels a side).");
-    v("smoothness_initial", smoothness_initial, "Jacobian smoothness weight at the first iteration.");
+    v("smoothness_initial", smoothness_initial, "Jacobian smoothness weight at the first iteration (0, with smoothness_final 0: the term is off).");
     v("smoothness_final", smoothness_final, "Smoothness weight from mid-training on (exponential decay before).");
     v("smoothness_samples", smoothness_samples, "Random uvd samples per step for the smoothness term.");
     v("rig_position", rig_position,
