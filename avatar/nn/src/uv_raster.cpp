@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 #include "tega/core/error.h"
 
@@ -14,9 +15,18 @@ namespace {
 // them from falling through the crack in floating point.
 constexpr double kEdgeTolerance = 1e-9;
 
+std::vector<int32_t> every_face(const Mesh& mesh) {
+  std::vector<int32_t> faces(mesh.num_faces());
+  std::iota(faces.begin(), faces.end(), 0);
+  return faces;
+}
+
 }  // namespace
 
-UvRasterizer::UvRasterizer(const Mesh& mesh, int size) : size_(size), num_vertices_(mesh.num_vertices()) {
+UvRasterizer::UvRasterizer(const Mesh& mesh, int size) : UvRasterizer(mesh, size, every_face(mesh)) {}
+
+UvRasterizer::UvRasterizer(const Mesh& mesh, int size, const std::vector<int32_t>& faces)
+    : size_(size), num_vertices_(mesh.num_vertices()) {
   if (!mesh.has_uvs()) throw Error("UV rasterizer: the template mesh has no UVs");
   if (size <= 0) throw Error("UV rasterizer: texture size must be positive, not " + std::to_string(size));
   if (mesh.uv_faces.rows() != mesh.faces.rows())
@@ -31,7 +41,10 @@ UvRasterizer::UvRasterizer(const Mesh& mesh, int size) : size_(size), num_vertic
   auto vertices = vertices_.accessor<int64_t, 2>();
   auto weights = weights_.accessor<float, 2>();
 
-  for (int f = 0; f < mesh.num_faces(); ++f) {
+  for (const int32_t f : faces) {
+    if (f < 0 || f >= mesh.num_faces())
+      throw Error("UV rasterizer: face " + std::to_string(f) + " is not one of the template's " +
+                  std::to_string(mesh.num_faces()) + " faces");
     double u[3], v[3];
     for (int k = 0; k < 3; ++k) {
       const int t = mesh.uv_faces(f, k);

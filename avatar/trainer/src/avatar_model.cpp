@@ -38,6 +38,19 @@ at::Tensor to_tensor(const Vertices& v, const at::Device& device) {
                                                                                     /*copy=*/true);
 }
 
+// The triangles the field moves: all but the eyeballs. The displacement
+// texture draws only these, since the rigid eyeballs tell nothing of the
+// expression and, where they share the face's UV tile (ICT-FaceKit), would
+// hide it.
+std::vector<int32_t> deformable_faces(const Dataset& dataset) {
+  std::vector<bool> eyeball(dataset.template_mesh.num_faces(), false);
+  for (const int32_t f : dataset.eyeball_faces) eyeball.at(f) = true;  // read_dataset checked the range
+  std::vector<int32_t> faces;
+  for (int32_t f = 0; f < dataset.template_mesh.num_faces(); ++f)
+    if (!eyeball[f]) faces.push_back(f);
+  return faces;
+}
+
 at::Tensor to_tensor(const Eigen::Matrix3d& m, const at::Device& device) {
   const Eigen::Matrix<float, 3, 3, Eigen::RowMajor> f = m.cast<float>();
   return at::from_blob(const_cast<float*>(f.data()), {3, 3}, at::kFloat).to(device, false, true);
@@ -48,7 +61,8 @@ at::Tensor to_tensor(const Eigen::Matrix3d& m, const at::Device& device) {
 AvatarModel::AvatarModel(const Dataset& dataset, const TrainOptions& options, const at::Device& device)
     : device_(device),
       lookup_(uvd::UvTriangleLookup(dataset.template_mesh, options.uv_lookup).to(device)),
-      uv_rasterizer_(nn::UvRasterizer(dataset.template_mesh, options.network.texture_size).to(device)),
+      uv_rasterizer_(
+          nn::UvRasterizer(dataset.template_mesh, options.network.texture_size, deformable_faces(dataset)).to(device)),
       template_vertices_(to_tensor(dataset.template_mesh.positions, device)),
       metres_per_uv_(trainer::metres_per_uv(dataset.template_mesh)) {
   eyeball_face_mask_ = at::zeros({dataset.template_mesh.num_faces()}, at::TensorOptions(at::kBool));

@@ -1,6 +1,7 @@
 #include "tega/trainer/trained_avatar.h"
 
 #include "tega/core/error.h"
+#include "tega/core/log.h"
 #include "tega/core/options.h"
 #include "tega/nn/module_io.h"
 #include "tega/trainer/checkpoint.h"
@@ -20,6 +21,14 @@ TrainedAvatar load_avatar(const std::filesystem::path& run, const Dataset& datas
   avatar.phase.deformation = options.deformation_field;
   avatar.phase.shading = options.dynamic_shading;
   avatar.phase.sh_degree = options.sh_degree;
+  const bool networks = options.deformation_field || options.dynamic_shading;
+  if (networks && !dataset.eyeball_faces.empty() && !checkpoint.metadata.count(kTextureMetadataKey)) {
+    logging::warn(
+        "%s: trained before the displacement texture left the eyeballs out; where they share the face's UV "
+        "tile (ICT-FaceKit) its networks learnt from a texture that hid the face's expression, and they now "
+        "see it: retrain the run (docs/training.md#the-encoders-blind-spot)",
+        file.string().c_str());
+  }
   return avatar;
 }
 

@@ -464,6 +464,7 @@ class Run {
     c.tensors["trainer.learning_rate_scale"] = at::tensor({learning_rate_scale_}, at::kDouble);
     c.tensors["trainer.rolled_back"] = at::tensor({int64_t{rolled_back_}}, at::kLong);
     c.metadata["options"] = options_to_yaml(options_);
+    c.metadata[kTextureMetadataKey] = kTextureWithoutEyeballs;
     // Kept until this one is written whole: killed in between, the run
     // resumes from it.
     if (fs::exists(run_dir_ / kCheckpoint)) fs::rename(run_dir_ / kCheckpoint, run_dir_ / kPreviousCheckpoint);

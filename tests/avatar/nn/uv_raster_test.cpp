@@ -96,6 +96,36 @@ TEST(UvRasterizer, GradientsReachTheVertexValues) {
   EXPECT_NEAR(values.grad().sum().item<float>(), 3 * 120, 1e-3);
 }
 
+// square_chart() plus a later triangle (its own vertices) laid over the whole
+// chart in UV, like ICT-FaceKit's eyeballs over its face.
+Mesh chart_under_an_overlay() {
+  const Mesh chart = square_chart();
+  Mesh mesh = chart;
+  mesh.positions.conservativeResize(7, 3);
+  mesh.positions.bottomRows(3) << 0, 0, 1, 1, 0, 1, 0, 1, 1;
+  mesh.faces.conservativeResize(3, 3);
+  mesh.faces.row(2) << 4, 5, 6;
+  mesh.uvs.conservativeResize(7, 2);
+  mesh.uvs.bottomRows(3) << 0.0f, 0.0f, 2.0f, 0.0f, 0.0f, 2.0f;
+  mesh.uv_faces.conservativeResize(3, 3);
+  mesh.uv_faces.row(2) << 4, 5, 6;
+  return mesh;
+}
+
+TEST(UvRasterizer, DrawsOnlyTheGivenFacesSoAnOverlayHidesNothing) {
+  const Mesh mesh = chart_under_an_overlay();
+  at::Tensor values = at::zeros({7, 1});
+  values.narrow(0, 0, 4).fill_(2.0);  // the chart's vertices; the overlay's stay 0
+  const at::Tensor all = UvRasterizer(mesh, kSize).rasterize(values)[0];
+  const at::Tensor chart_only = UvRasterizer(mesh, kSize, {0, 1}).rasterize(values)[0];
+  for (int r = 0; r < kSize; ++r)
+    for (int c = 0; c < kSize; ++c) {
+      EXPECT_FLOAT_EQ(chart_only[r][c].item<float>(), inside_chart(r, c) ? 2.0f : 0.0f) << r << "," << c;
+      EXPECT_FLOAT_EQ(all[r][c].item<float>(), 0.0f) << r << "," << c;  // the later overlay wins
+    }
+  EXPECT_THROW(UvRasterizer(mesh, kSize, {0, 3}), Error);
+}
+
 TEST(UvRasterizer, RejectsAMeshWithoutUvs) {
   Mesh mesh = square_chart();
   mesh.uvs.resize(0, 2);

@@ -12,12 +12,18 @@
 // bottom; sample_latent() (encoders.h) reads with the same convention.
 // Texels whose centre no UV triangle covers hold 0, which is also "no
 // displacement", so the encoder sees no spurious signal in the gaps. Where
-// UV triangles overlap (mirrored charts), the later triangle wins.
+// drawn UV triangles overlap (mirrored charts), the later triangle wins, so
+// parts that share the face's UV tile must be left out: ICT-FaceKit's eyeball
+// spheres cover all of tile 0 and come after the face, and drawn they hid
+// nearly every face texel (the encoder saw no expression).
 //
 // Interpolation is linear, so rasterize(x) - rasterize(neutral) equals
 // rasterize(x - neutral).
 
 #include <ATen/core/Tensor.h>
+
+#include <cstdint>
+#include <vector>
 
 #include "tega/core/mesh.h"
 
@@ -25,8 +31,10 @@ namespace tega::nn {
 
 class UvRasterizer {
  public:
-  // Throws tega::Error if the mesh has no UVs or size is not positive.
+  // Draws every triangle, or only `faces`. Throws tega::Error if the mesh has
+  // no UVs, size is not positive or a face index is out of range.
   UvRasterizer(const Mesh& mesh, int size);
+  UvRasterizer(const Mesh& mesh, int size, const std::vector<int32_t>& faces);
 
   // values [V,C] (V = mesh.num_vertices()) → [C,N,N], differentiable in values.
   // The tables must be on values' device (see to()).

@@ -15,6 +15,11 @@
 
 namespace tega::trainer {
 
+// Metadata key and value that say the networks were trained on a displacement
+// texture without the eyeball triangles (docs/training.md#the-encoders-blind-spot).
+inline constexpr const char* kTextureMetadataKey = "displacement_texture";
+inline constexpr const char* kTextureWithoutEyeballs = "without eyeballs";
+
 struct Checkpoint {
   std::map<std::string, at::Tensor> tensors;
   std::map<std::string, std::string> metadata;
