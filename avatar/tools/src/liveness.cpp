@@ -146,6 +146,27 @@ class SplitErrors {
   Sums mesh_, corrected_;
 };
 
+// Each Gaussian's spread over frames of a per-frame value x [N,k]: the root
+// mean square over frames of |x - x̄|, averaged over Gaussians.
+class FrameSpread {
+ public:
+  void add(const at::Tensor& x) {
+    const at::Tensor rows = x.to(at::kDouble).view({x.size(0), -1});
+    sum_ = sum_.defined() ? sum_ + rows : rows;
+    squares_ = squares_.defined() ? squares_ + rows.pow(2).sum(1) : rows.pow(2).sum(1);
+    ++frames_;
+  }
+  double mean_over_gaussians() const {
+    if (frames_ == 0) return 0.0;
+    const at::Tensor mean = sum_ / double(frames_);
+    return (squares_ / double(frames_) - mean.pow(2).sum(1)).clamp_min(0).sqrt().mean().item<double>();
+  }
+
+ private:
+  at::Tensor sum_, squares_;
+  int frames_ = 0;
+};
+
 // The network part a parameter belongs to, by its registered path.
 std::string network_part(const std::string& name) {
   const std::string head = name.substr(0, name.find('.'));
@@ -224,7 +245,7 @@ Liveness inspect_avatar(trainer::TrainedAvatar& avatar, const Dataset& dataset, 
   without_field.deformation = false;
 
   std::vector<double> expression, deformation, shading_change;
-  at::Tensor shading_sum, shading_square_sum;
+  FrameSpread deformation_spread, shading_spread;
   std::optional<TrueMeshes> truth;
   if (!options.truth.empty()) truth.emplace(options.truth);
   const std::set<std::string> held_out(dataset.test.frames.begin(), dataset.test.frames.end());
@@ -256,14 +277,15 @@ Liveness inspect_avatar(trainer::TrainedAvatar& avatar, const Dataset& dataset, 
         const at::Tensor moving = moved.index({moved > 1e-6});  // eyeballs stay put
         frame.deformation_mean_mm = moving.numel() ? moving.mean().item<double>() : 0.0;
         frame.deformation_p95_mm = quantile_of(moving, 0.95);
+        // Head space, so that the head's motion is not counted as the field's.
+        deformation_spread.add((deformed - placed).matmul(input.head_rotation) * 1000.0);
       }
       if (out.shading) {
         const at::Tensor s = model.network->shade(g.uvd, model.network->encode(input.displacement_texture)).to(at::kDouble);
         frame.shading_p01 = quantile_of(s, 0.01);
         frame.shading_p50 = quantile_of(s, 0.5);
         frame.shading_p99 = quantile_of(s, 0.99);
-        shading_sum = shading_sum.defined() ? shading_sum + s : s;
-        shading_square_sum = shading_square_sum.defined() ? shading_square_sum + s * s : s * s;
+        shading_spread.add(s.unsqueeze(1));
         shading_change.push_back((s - 1.0).abs().mean().item<double>());
       }
       expression.push_back(frame.expression_mm);
@@ -282,11 +304,8 @@ Liveness inspect_avatar(trainer::TrainedAvatar& avatar, const Dataset& dataset, 
       out.varying_error_undone_test = test_errors.varying_undone();
     }
     out.shading_expression_r = out.shading ? pearson(expression, shading_change) : std::nan("");
-    if (shading_sum.defined()) {
-      const double n = double(dataset.frames.size());
-      const at::Tensor mean = shading_sum / n;
-      out.shading_frame_std = (shading_square_sum / n - mean * mean).clamp_min(0).sqrt().mean().item<double>();
-    }
+    out.deformation_frame_std_mm = deformation_spread.mean_over_gaussians();
+    out.shading_frame_std = shading_spread.mean_over_gaussians();
     if (g.birth_triangle.defined() && !g.rigged && !g.bound_triangle.defined()) {
       const at::Tensor now = model.lookup().lookup(g.uvd.detach().slice(1, 0, 2)).triangle;
       out.off_birth_triangle = now.ne(g.birth_triangle).to(at::kDouble).mean().item<double>();
@@ -347,6 +366,7 @@ nlohmann::json liveness_json(const Liveness& l) {
           {"deformation", l.deformation},
           {"shading", l.shading},
           {"deformation_expression_r", number(l.deformation_expression_r)},
+          {"deformation_frame_std_mm", l.deformation ? number(l.deformation_frame_std_mm) : nlohmann::json(nullptr)},
           {"shading_frame_std", l.shading ? number(l.shading_frame_std) : nlohmann::json(nullptr)},
           {"shading_expression_r", number(l.shading_expression_r)},
           {"off_birth_triangle", optional_number(l.off_birth_triangle)},
@@ -371,7 +391,8 @@ std::string liveness_markdown(const Liveness& l, const std::string& name) {
   std::string out = "## " + name + " (iteration " + std::to_string(l.iteration) + ", " +
                     std::to_string(l.gaussians) + " Gaussians)\n\n";
   out += l.deformation ? "- deformation field: mean |Δμ| " + fixed(deformation_mean, 3) + " mm over frames, largest p95 " +
-                             fixed(deformation_p95, 3) + " mm; r with the expression " +
+                             fixed(deformation_p95, 3) + " mm, per-Gaussian std over frames " +
+                             fixed(l.deformation_frame_std_mm, 3) + " mm; r with the expression " +
                              fixed(l.deformation_expression_r, 2) + "\n"
                        : "- deformation field: off\n";
   out += l.shading ? "- dynamic shading: S from " + fixed(s_low, 3) + " to " + fixed(s_high, 3) +

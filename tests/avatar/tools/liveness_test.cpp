@@ -1,5 +1,6 @@
 // tega inspect's liveness figures on the tiny avatar: a perturbed network
-// moves and shades Gaussians and every part gets a gradient; a field whose
+// moves and shades Gaussians differently per frame and every part gets a
+// gradient; a field whose
 // output layer is zero moves nothing; parts switched off are reported off;
 // Gaussians off their birth triangle are counted; against a virtual-studio
 // ground truth, the share of the meshes' error the field undoes, all of it
@@ -56,6 +57,11 @@ double gradient_of(const Liveness& l, const std::string& part) {
 
 TEST(Liveness, PartsOfAPerturbedAvatarAreAliveAndReported) {
   test::TinyAvatar tiny;
+  // The blink frame's mesh, otherwise the smile's, gets its own expression:
+  // one corner 5 mm out of the plane.
+  Vertices blink = tiny.dataset.load_mesh("blink_000000");
+  blink(2, 2) += 0.005f;
+  write_vertices_bin(blink, tiny.dataset.mesh_path("blink_000000"));
   const Liveness l = inspect_avatar(*tiny.avatar, tiny.dataset, {});
   EXPECT_TRUE(l.deformation);
   EXPECT_TRUE(l.shading);
@@ -66,12 +72,16 @@ TEST(Liveness, PartsOfAPerturbedAvatarAreAliveAndReported) {
     EXPECT_GE(f.deformation_p95_mm, f.deformation_mean_mm * 0.5) << f.frame;
     EXPECT_LT(f.shading_p01, f.shading_p99) << f.frame;
   }
+  // The two frames' expressions differ, and so do the networks' outputs.
+  EXPECT_GT(l.deformation_frame_std_mm, 0.0);
+  EXPECT_GT(l.shading_frame_std, 0.0);
   for (const char* part : {"gaussians.uvd", "gaussians.sh_dc", "network.encoder", "network.deformation",
                            "network.shading"})
     EXPECT_GT(gradient_of(l, part), 0.0) << part;
   EXPECT_FALSE(l.off_birth_triangle.has_value());
   const nlohmann::json j = liveness_json(l);
   EXPECT_EQ(j.at("frames").size(), 2u);
+  EXPECT_DOUBLE_EQ(j.at("deformation_frame_std_mm").get<double>(), l.deformation_frame_std_mm);
   EXPECT_NE(liveness_markdown(l, "tiny").find("deformation field: mean"), std::string::npos);
 }
 
@@ -166,7 +176,9 @@ TEST(Liveness, AConstantFieldUndoesNoneOfTheFrameToFramePartOfTheError) {
   EXPECT_NEAR(*l.varying_error_mm_train, 1.0, 1e-3);
   EXPECT_NEAR(*l.varying_error_undone_train, 0.0, 1e-3);
   EXPECT_FALSE(l.varying_error_mm_test.has_value());  // no held-out frames
+  EXPECT_NEAR(l.deformation_frame_std_mm, 0.0, 1e-4);  // the same 3 mm in every frame
   const std::string text = liveness_markdown(l, "varying");
+  EXPECT_NE(text.find("per-Gaussian std over frames 0.000 mm"), std::string::npos) << text;
   EXPECT_NE(text.find("frame-to-frame part"), std::string::npos) << text;
   EXPECT_NE(text.find("1.000 mm on training frames, 0.0 % of it undone"), std::string::npos) << text;
   EXPECT_NEAR(liveness_json(l).at("varying_error_mm_train").get<double>(), 1.0, 1e-3);

@@ -67,6 +67,7 @@ struct Liveness {
   bool deformation = false, shading = false;
   std::vector<FrameLiveness> frames;      // every dataset frame
   double deformation_expression_r = 0;    // NaN where undefined (constant series)
+  double deformation_frame_std_mm = 0;    // mean over Gaussians of Δμ's std over frames (head space)
   double shading_frame_std = 0;           // mean over Gaussians of S's std over frames
   double shading_expression_r = 0;
   std::optional<double> off_birth_triangle;  // fraction; absent when the run does not track it
