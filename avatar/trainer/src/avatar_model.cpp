@@ -38,6 +38,11 @@ at::Tensor to_tensor(const Vertices& v, const at::Device& device) {
                                                                                     /*copy=*/true);
 }
 
+at::Tensor to_tensor(const Eigen::Matrix3d& m, const at::Device& device) {
+  const Eigen::Matrix<float, 3, 3, Eigen::RowMajor> f = m.cast<float>();
+  return at::from_blob(const_cast<float*>(f.data()), {3, 3}, at::kFloat).to(device, false, true);
+}
+
 // The triangles the field moves: all but the eyeballs. The displacement
 // texture draws only these, since the rigid eyeballs tell nothing of the
 // expression and, where they share the face's UV tile (ICT-FaceKit), would
@@ -49,11 +54,6 @@ std::vector<int32_t> deformable_faces(const Dataset& dataset) {
   for (int32_t f = 0; f < dataset.template_mesh.num_faces(); ++f)
     if (!eyeball[f]) faces.push_back(f);
   return faces;
-}
-
-at::Tensor to_tensor(const Eigen::Matrix3d& m, const at::Device& device) {
-  const Eigen::Matrix<float, 3, 3, Eigen::RowMajor> f = m.cast<float>();
-  return at::from_blob(const_cast<float*>(f.data()), {3, 3}, at::kFloat).to(device, false, true);
 }
 
 }  // namespace
