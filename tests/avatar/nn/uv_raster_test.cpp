@@ -99,8 +99,7 @@ TEST(UvRasterizer, GradientsReachTheVertexValues) {
 // square_chart() plus a later triangle (its own vertices) laid over the whole
 // chart in UV, like ICT-FaceKit's eyeballs over its face.
 Mesh chart_under_an_overlay() {
-  const Mesh chart = square_chart();
-  Mesh mesh = chart;
+  Mesh mesh = square_chart();
   mesh.positions.conservativeResize(7, 3);
   mesh.positions.bottomRows(3) << 0, 0, 1, 1, 0, 1, 0, 1, 1;
   mesh.faces.conservativeResize(3, 3);
