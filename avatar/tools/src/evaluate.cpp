@@ -59,7 +59,7 @@ std::vector<SplitResult> evaluate_avatar(trainer::TrainedAvatar& avatar, const D
   const at::Device device = avatar.model.device();
   const at::Tensor background = at::tensor(avatar.options.background, at::kFloat).to(device);
   std::optional<LandmarkProbe> landmarks;
-  if (!dataset.landmark_vertices.empty()) landmarks.emplace(dataset, device);
+  if (!dataset.landmark_vertices.empty()) landmarks.emplace(dataset, avatar.model);
   std::optional<Lpips> lpips_here;
   if (lpips) lpips_here = lpips->to(device);
 

@@ -9,8 +9,10 @@
 
 namespace tega::tools {
 
-LandmarkProbe::LandmarkProbe(const Dataset& dataset, const at::Device& device) : vertices_(dataset.landmark_vertices) {
-  const Mesh& mesh = dataset.template_mesh;
+LandmarkProbe::LandmarkProbe(const Dataset& dataset, const trainer::AvatarModel& model)
+    : vertices_(dataset.landmark_vertices) {
+  const Mesh& mesh = model.uv_layout();
+  const at::Device device = model.device();
   at::Tensor uvd = at::zeros({static_cast<int64_t>(vertices_.size()), 3}, at::kFloat);
   for (size_t l = 0; l < vertices_.size(); ++l) {
     const int32_t vertex = vertices_[l];

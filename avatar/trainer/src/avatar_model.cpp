@@ -9,6 +9,7 @@
 #include "tega/trainer/spherical_harmonics.h"
 #include "tega/uvd/fused_covariance.h"
 #include "tega/uvd/triangle_rig.h"
+#include "tega/uvd/uv_layout.h"
 
 namespace tega::trainer {
 
@@ -45,8 +46,7 @@ at::Tensor to_tensor(const Eigen::Matrix3d& m, const at::Device& device) {
 
 // The triangles the field moves: all but the eyeballs. The displacement
 // texture draws only these, since the rigid eyeballs tell nothing of the
-// expression and, where they share the face's UV tile (ICT-FaceKit), would
-// hide it.
+// expression and would take texels from it.
 std::vector<int32_t> deformable_faces(const Dataset& dataset) {
   std::vector<bool> eyeball(dataset.template_mesh.num_faces(), false);
   for (const int32_t f : dataset.eyeball_faces) eyeball.at(f) = true;  // read_dataset checked the range
@@ -60,11 +60,11 @@ std::vector<int32_t> deformable_faces(const Dataset& dataset) {
 
 AvatarModel::AvatarModel(const Dataset& dataset, const TrainOptions& options, const at::Device& device)
     : device_(device),
-      lookup_(uvd::UvTriangleLookup(dataset.template_mesh, options.uv_lookup).to(device)),
-      uv_rasterizer_(
-          nn::UvRasterizer(dataset.template_mesh, options.network.texture_size, deformable_faces(dataset)).to(device)),
+      uv_layout_(uvd::with_part_laid_apart(dataset.template_mesh, dataset.eyeball_faces)),
+      lookup_(uvd::UvTriangleLookup(uv_layout_, options.uv_lookup).to(device)),
+      uv_rasterizer_(nn::UvRasterizer(uv_layout_, options.network.texture_size, deformable_faces(dataset)).to(device)),
       template_vertices_(to_tensor(dataset.template_mesh.positions, device)),
-      metres_per_uv_(trainer::metres_per_uv(dataset.template_mesh)) {
+      metres_per_uv_(trainer::metres_per_uv(uv_layout_)) {
   eyeball_face_mask_ = at::zeros({dataset.template_mesh.num_faces()}, at::TensorOptions(at::kBool));
   for (int32_t f : dataset.eyeball_faces) eyeball_face_mask_[f] = true;
   eyeball_face_mask_ = eyeball_face_mask_.to(device);

@@ -69,7 +69,7 @@ TEST(Eval, ScoresTheViewsOfThePapersProtocol) {
 TEST(Eval, LandmarkDriftFollowsTheDeformationField) {
   test::TinyAvatar tiny;
   tiny.dataset.landmark_vertices = {0, 1, 2};
-  const LandmarkProbe probe(tiny.dataset, at::kCPU);
+  const LandmarkProbe probe(tiny.dataset, tiny.model());
   const Vertices vertices = tiny.dataset.load_mesh("blink_000000");
   const trainer::FrameInput input = tiny.model().frame_input(vertices, tiny.dataset.frame("blink_000000").head_to_world);
   const Camera& camera = tiny.dataset.rig.camera("cam00");

@@ -28,8 +28,9 @@ namespace tega::tools {
 
 class LandmarkProbe {
  public:
-  // Throws tega::Error when a landmark vertex is out of range or in no face with UVs.
-  LandmarkProbe(const Dataset& dataset, const at::Device& device);
+  // For the model's avatar: its device and UV layout. Throws tega::Error when
+  // a landmark vertex is out of range or in no face with UVs.
+  LandmarkProbe(const Dataset& dataset, const trainer::AvatarModel& model);
 
   bool empty() const { return vertices_.empty(); }
 

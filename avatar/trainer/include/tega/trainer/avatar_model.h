@@ -60,6 +60,9 @@ class AvatarModel {
   Gaussians gaussians;
   nn::ExpressionNetwork network{nullptr};
 
+  // The template's UVs as the Gaussians use them: the eyeballs laid apart
+  // from the face where they share its UV tile (uvd/uv_layout.h).
+  const Mesh& uv_layout() const { return uv_layout_; }
   const uvd::UvTriangleLookup& lookup() const { return lookup_; }
   double metres_per_uv() const { return metres_per_uv_; }
   // Mean scale k (metres) of the template's active triangles: metres per
@@ -69,6 +72,7 @@ class AvatarModel {
 
  private:
   at::Device device_;
+  Mesh uv_layout_;
   uvd::UvTriangleLookup lookup_;
   nn::UvRasterizer uv_rasterizer_;
   at::Tensor template_vertices_;  // [V,3] head space
