@@ -36,7 +36,7 @@ TEST(AblationStudy, TrainsEveryRowAndSeedThenTabulatesAndInspectsThem) {
   if (!tega_trains()) GTEST_SKIP() << "this tega has no train command (no libtorch)";
   TempDir tmp;
   write_text(tmp / "rows", "# a row of the user's own\npyramid --set loss.pyramid_l1=1 --set loss.pyramid_levels=2\n");
-  const auto r = run_command(tiny_study_environment(tmp) + "VARIANTS='full gaussian-avatars' ROWS_FILE=" +
+  const auto r = run_command(tiny_study_environment(tmp) + "GPUS='0 1' VARIANTS='full gaussian-avatars' ROWS_FILE=" +
                              (tmp / "rows").string() + " bash " + kScript + " " + (tmp / "study").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
 
@@ -52,6 +52,12 @@ TEST(AblationStudy, TrainsEveryRowAndSeedThenTabulatesAndInspectsThem) {
   EXPECT_NE(table.find("Seeds 0, 1."), std::string::npos) << table;
   for (const char* row : {"| full |", "| gaussian-avatars |", "| pyramid |"})
     EXPECT_NE(table.find(row), std::string::npos) << row << "\n" << table;
+
+  // Round robin over GPUS, rows x seeds in order (on the CPU the device index only names the run's share).
+  EXPECT_NE(read_text_file(tmp / "study/logs/full.s1.log").find("full.s1 to iteration 12 on GPU 1"),
+            std::string::npos);
+  EXPECT_NE(read_text_file(tmp / "study/logs/gaussian-avatars.s0.log").find("on GPU 0"), std::string::npos);
+  EXPECT_NE(read_text_file(tmp / "study/logs/pyramid.s1.log").find("on GPU 1"), std::string::npos);
 
   // The row's flags reached its runs, and only its runs.
   EXPECT_NE(read_text_file(tmp / "study/runs/pyramid.s1/options.yaml").find("pyramid_l1: 1"), std::string::npos);
@@ -80,6 +86,14 @@ TEST(AblationStudy, ARowOfTheRowsFileMustBeNewAndWellNamed) {
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("ROWS_FILE: no file"), std::string::npos) << r.output;
   EXPECT_FALSE(std::filesystem::exists(tmp / "study/capture"));  // refused before any work
+}
+
+TEST(AblationStudy, GpusAreCudaDeviceIndices) {
+  TempDir tmp;
+  const auto r = run_command("GPUS='0 cuda:1' VARIANTS='full' bash " + kScript + " " + (tmp / "study").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("GPUS: 'cuda:1' is not a CUDA device index"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(tmp / "study/capture"));
 }
 
 }  // namespace
