@@ -4,6 +4,7 @@
 #include <ATen/record_function.h>
 
 #include <cmath>
+#include <numeric>
 
 #include "tega/core/error.h"
 #include "tega/trainer/spherical_harmonics.h"
@@ -14,18 +15,11 @@
 namespace tega::trainer {
 
 double metres_per_uv(const Mesh& mesh) {
-  double world = 0, uv = 0;
-  for (int f = 0; f < mesh.num_faces(); ++f) {
-    const Eigen::Vector3f a = mesh.positions.row(mesh.faces(f, 0)), b = mesh.positions.row(mesh.faces(f, 1)),
-                          c = mesh.positions.row(mesh.faces(f, 2));
-    world += 0.5 * (b - a).cross(c - a).norm();
-    const Eigen::Vector2f p = mesh.uvs.row(mesh.uv_faces(f, 0)), q = mesh.uvs.row(mesh.uv_faces(f, 1)),
-                          r = mesh.uvs.row(mesh.uv_faces(f, 2));
-    const Eigen::Vector2f e1 = q - p, e2 = r - p;
-    uv += 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
-  }
-  if (uv <= 0) throw Error("the template's UV layout has no area");
-  return std::sqrt(world / uv);
+  std::vector<int32_t> faces(mesh.num_faces());
+  std::iota(faces.begin(), faces.end(), 0);
+  const uvd::SurfaceAreas areas = uvd::surface_areas(mesh, faces);
+  if (areas.uv <= 0) throw Error("the template's UV layout has no area");
+  return std::sqrt(areas.world / areas.uv);
 }
 
 namespace {

@@ -11,27 +11,13 @@
 namespace tega::uvd {
 namespace {
 
-struct Areas {
-  double uv = 0, world = 0;
-};
-
-Areas areas(const Mesh& mesh, const std::vector<int32_t>& faces) {
-  Areas a;
-  for (const int32_t f : faces) {
-    const Eigen::Vector3f p = mesh.positions.row(mesh.faces(f, 0)), q = mesh.positions.row(mesh.faces(f, 1)),
-                          r = mesh.positions.row(mesh.faces(f, 2));
-    a.world += 0.5 * (q - p).cross(r - p).norm();
-    const Eigen::Vector2f s = mesh.uvs.row(mesh.uv_faces(f, 0)), t = mesh.uvs.row(mesh.uv_faces(f, 1)),
-                          u = mesh.uvs.row(mesh.uv_faces(f, 2));
-    const Eigen::Vector2f e1 = t - s, e2 = u - s;
-    a.uv += 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
-  }
-  return a;
-}
+// Lookups are exact at any resolution; a coarse grid builds in a fraction of
+// the default's time, and these two lookups are built at every model's start.
+constexpr double kOverlapTestResolution = 128;
 
 // Whether a UV centroid of one group's triangles lies inside the other's.
 bool centroids_inside(const Mesh& mesh, const std::vector<int32_t>& of, const std::vector<int32_t>& in) {
-  const UvTriangleLookup other(mesh, {}, in);
+  const UvTriangleLookup other(mesh, {kOverlapTestResolution, 0.1}, in);
   at::Tensor centroids = at::empty({static_cast<int64_t>(of.size()), 2}, at::kDouble);
   auto c = centroids.accessor<double, 2>();
   for (size_t i = 0; i < of.size(); ++i)
@@ -45,6 +31,20 @@ bool centroids_inside(const Mesh& mesh, const std::vector<int32_t>& of, const st
 
 }  // namespace
 
+SurfaceAreas surface_areas(const Mesh& mesh, const std::vector<int32_t>& faces) {
+  SurfaceAreas a;
+  for (const int32_t f : faces) {
+    const Eigen::Vector3f p = mesh.positions.row(mesh.faces(f, 0)), q = mesh.positions.row(mesh.faces(f, 1)),
+                          r = mesh.positions.row(mesh.faces(f, 2));
+    a.world += 0.5 * (q - p).cross(r - p).norm();
+    const Eigen::Vector2f s = mesh.uvs.row(mesh.uv_faces(f, 0)), t = mesh.uvs.row(mesh.uv_faces(f, 1)),
+                          u = mesh.uvs.row(mesh.uv_faces(f, 2));
+    const Eigen::Vector2f e1 = t - s, e2 = u - s;
+    a.uv += 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
+  }
+  return a;
+}
+
 Mesh with_part_laid_apart(const Mesh& mesh, const std::vector<int32_t>& part) {
   if (!mesh.has_uvs()) throw Error("the template has no UVs to lay out");
   std::vector<bool> in_part(mesh.num_faces(), false);
@@ -56,7 +56,7 @@ Mesh with_part_laid_apart(const Mesh& mesh, const std::vector<int32_t>& part) {
   }
   std::vector<int32_t> moved, rest;
   for (int32_t f = 0; f < mesh.num_faces(); ++f) (in_part[f] ? moved : rest).push_back(f);
-  const Areas a_moved = areas(mesh, moved), a_rest = areas(mesh, rest);
+  const SurfaceAreas a_moved = surface_areas(mesh, moved), a_rest = surface_areas(mesh, rest);
   if (a_moved.uv <= 0 || a_rest.uv <= 0) return mesh;
   if (!centroids_inside(mesh, moved, rest) && !centroids_inside(mesh, rest, moved)) return mesh;
   const double scale = a_moved.world > 0 ? std::sqrt((a_rest.uv / a_rest.world) / (a_moved.uv / a_moved.world)) : 1.0;

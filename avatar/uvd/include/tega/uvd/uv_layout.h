@@ -14,6 +14,12 @@
 
 namespace tega::uvd {
 
+// The summed UV and world areas of the given triangles.
+struct SurfaceAreas {
+  double uv = 0, world = 0;
+};
+SurfaceAreas surface_areas(const Mesh& mesh, const std::vector<int32_t>& faces);
+
 // `mesh` with the triangles of `part` given a UV island of their own when
 // any of them overlaps the rest's UVs; otherwise `mesh` unchanged. The moved
 // island is scaled to the rest's UV density (UV area per world area), so
