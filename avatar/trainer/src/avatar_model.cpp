@@ -50,6 +50,14 @@ std::vector<int32_t> deformable_faces(const Dataset& dataset) {
   return faces;
 }
 
+// [length, Gaussian, triangle, u, v] of the longest row of `moves` [N,3].
+at::Tensor largest(const at::Tensor& moves, const at::Tensor& triangle, const at::Tensor& uvd) {
+  const auto [length, index] = moves.norm(2, 1).max(0);
+  const at::Tensor row = index.view({1});
+  return at::cat({length.view({1}).to(at::kDouble), row.to(at::kDouble), triangle.index_select(0, row).to(at::kDouble),
+                  uvd.index_select(0, row).narrow(1, 0, 2).view({2}).to(at::kDouble)});
+}
+
 }  // namespace
 
 AvatarModel::AvatarModel(const Dataset& dataset, const TrainOptions& options, const at::Device& device)
@@ -115,7 +123,7 @@ PosedGaussians AvatarModel::pose(const FrameInput& frame, const Phase& phase) {
       // Head space -> world: Δ_world = R Δ, J_world = R J (row vectors: Δ Rᵀ).
       const at::Tensor applied = field.value * movable.unsqueeze(1);
       means = means + applied.matmul(frame.head_rotation.t());
-      out.largest_deformation = applied.detach().norm(2, 1).amax();
+      out.largest_deformation = largest(applied.detach(), triangle, g.uvd.detach());
       // R J_D for every Gaussian as one [3N,3]x[3,3] product: (J_Dᵀ Rᵀ)ᵀ.
       const at::Tensor rotated = field.jacobian.transpose(1, 2).reshape({-1, 3}).matmul(frame.head_rotation.t());
       jacobian = jacobian + rotated.view({-1, 3, 3}).transpose(1, 2) * movable.view({-1, 1, 1});

@@ -15,10 +15,17 @@
 
 namespace tega::trainer {
 
+// The Gaussian that the field moved furthest in a step.
+struct LargestDeformation {
+  double metres = 0;  // 0 while the field is off
+  int64_t gaussian = -1, triangle = -1;
+  double u = 0, v = 0;  // canonical
+};
+
 struct StepValues {
   double loss = 0, mse = 0;
   bool finite = true;     // the loss and every gradient
-  double largest_deformation = 0;  // metres; 0 while the field is off
+  LargestDeformation largest_deformation;
   int64_t iteration = 0;  // 1-based
   View view;
 };
@@ -26,7 +33,8 @@ struct StepValues {
 class StepReadout {
  public:
   // Queues the copy of one step's 0-d loss, mse, finite flag and largest
-  // deformation (undefined: 0). At most one step is queued: pop() it first.
+  // deformation (PosedGaussians::largest_deformation; undefined: none). At
+  // most one step is queued: pop() it first.
   void push(const at::Tensor& loss, const at::Tensor& mse, const at::Tensor& finite,
             const at::Tensor& largest_deformation, int64_t iteration, const View& view);
   // The queued step's values (waiting for their copy if it is still running),
@@ -35,7 +43,7 @@ class StepReadout {
 
  private:
   struct Pending {
-    at::Tensor host;  // [4] double: loss, mse, finite, largest deformation
+    at::Tensor host;  // [8] double: loss, mse, finite, then the largest deformation's 5
     std::optional<c10::Event> copied;
     int64_t iteration;
     View view;

@@ -358,9 +358,11 @@ class Run {
   // field that ran away.
   std::string failure(const StepValues& values) const {
     if (!values.finite) return "the loss or a gradient is NaN/Inf";
-    if (options_.max_deformation > 0 && !(values.largest_deformation <= options_.max_deformation))
-      return "the deformation field moved a Gaussian " + format_number(values.largest_deformation) +
-             " m, more than max_deformation (" + format_number(options_.max_deformation) + " m)";
+    const LargestDeformation& d = values.largest_deformation;
+    if (options_.max_deformation > 0 && !(d.metres <= options_.max_deformation))
+      return "the deformation field moved a Gaussian " + format_number(d.metres) + " m, more than max_deformation (" +
+             format_number(options_.max_deformation) + " m): Gaussian " + std::to_string(d.gaussian) + " at uv (" +
+             format_number(d.u) + ", " + format_number(d.v) + "), template triangle " + std::to_string(d.triangle);
     return "";
   }
 

@@ -47,7 +47,10 @@ struct PosedGaussians {
   at::Tensor opacities;    // [N] in (0,1)
   at::Tensor world_std_per_scale;  // [N,3] world std per unit of exp(log_scale) (no grad)
   nn::Latents latents;     // this frame's latents (undefined when the field is off)
-  at::Tensor largest_deformation;  // 0-d: the longest Δμ applied (metres, no grad); undefined when the field is off
+  // The longest Δμ applied, as [5] double (no grad): its length (metres), the
+  // Gaussian's index, its triangle and its canonical u, v; undefined when the
+  // field is off. A run that rolls back names that Gaussian.
+  at::Tensor largest_deformation;
 };
 
 class AvatarModel {
