@@ -62,7 +62,7 @@ at::Tensor largest(const at::Tensor& moves, const at::Tensor& triangle, const at
 
 AvatarModel::AvatarModel(const Dataset& dataset, const TrainOptions& options, const at::Device& device)
     : device_(device),
-      uv_layout_(uvd::with_part_laid_apart(dataset.template_mesh, dataset.eyeball_faces)),
+      uv_layout_(uvd::packed_in_unit_square(uvd::with_part_laid_apart(dataset.template_mesh, dataset.eyeball_faces))),
       lookup_(uvd::UvTriangleLookup(uv_layout_, options.uv_lookup).to(device)),
       uv_rasterizer_(nn::UvRasterizer(uv_layout_, options.network.texture_size, deformable_faces(dataset)).to(device)),
       template_vertices_(to_tensor(dataset.template_mesh.positions, device)),
@@ -160,6 +160,17 @@ PosedGaussians AvatarModel::pose(const FrameInput& frame, const Phase& phase) {
     out.opacities = at::sigmoid(g.opacity_logit);
   }
   return out;
+}
+
+void check_uv_layout(const Checkpoint& checkpoint, const std::filesystem::path& file, const AvatarModel& model,
+                     const Mesh& template_mesh, bool rigged) {
+  const Mesh& layout = model.uv_layout();
+  const bool as_the_template = layout.uvs == template_mesh.uvs && layout.uv_faces == template_mesh.uv_faces;
+  if (rigged || as_the_template || checkpoint.metadata.count(kUvLayoutMetadataKey)) return;
+  throw Error(file,
+              "was trained in an earlier UV layout of this template (before its overlapping charts were laid apart "
+              "one by one and its UV tiles packed into the unit square), where its Gaussians' uv name other points "
+              "of the head: retrain the run (docs/uvd-rigging.md#multi-tile-layouts-packed-into-the-unit-square)");
 }
 
 }  // namespace tega::trainer

@@ -467,6 +467,7 @@ class Run {
     c.tensors["trainer.rolled_back"] = at::tensor({int64_t{rolled_back_}}, at::kLong);
     c.metadata["options"] = options_to_yaml(options_);
     c.metadata[kTextureMetadataKey] = kTextureWithoutEyeballs;
+    c.metadata[kUvLayoutMetadataKey] = kUvLayoutChartsApartPacked;
     // Kept until this one is written whole: killed in between, the run
     // resumes from it.
     if (fs::exists(run_dir_ / kCheckpoint)) fs::rename(run_dir_ / kCheckpoint, run_dir_ / kPreviousCheckpoint);
@@ -494,6 +495,7 @@ class Run {
   }
 
   void restore(const Checkpoint& c, const fs::path& file) {
+    check_uv_layout(c, file, model_, dataset_.template_mesh, options_.binding == "rigged");
     model_.gaussians = gaussians_from_tensors(c.tensors, device_, options_.binding == "rigged");
     nn::load_module_tensors(*model_.network, c.tensors, file, "network.");
     register_parameters();

@@ -1,6 +1,7 @@
 // load_avatar on a run whose networks learnt from the displacement texture
 // before it left the eyeballs out: it still loads, with a warning that says
-// to retrain; a run trained since loads without one.
+// to retrain; a run trained since loads without one. A run from an earlier
+// UV layout is refused.
 
 #include "tega/trainer/trained_avatar.h"
 
@@ -57,6 +58,31 @@ TEST(LoadAvatar, ARunTrainedOnTheTextureWithEyeballsIsLoadedWithAWarningToRetrai
 
   const auto since = write_run(tiny, {{kTextureMetadataKey, kTextureWithoutEyeballs}});
   EXPECT_EQ(warnings_of_loading(since, with_eyeballs), "");
+}
+
+// A run of TeGA Gaussians from before the layout was packed into the unit
+// square is refused on a template that packing changes (its Gaussians' uv
+// would name other points); one trained since, or on a template packing
+// leaves as it is, loads.
+TEST(LoadAvatar, ARunFromAnEarlierUvLayoutOfItsTemplateIsRefused) {
+  test::TinyAvatar tiny;
+  Dataset two_tiles = tiny.dataset;
+  two_tiles.template_mesh.uvs.col(0).array() += 1.0f;  // tile 1: packing moves it
+
+  const auto before = write_run(tiny, {});
+  try {
+    load_avatar(before, two_tiles, at::kCPU);
+    FAIL() << "expected an error";
+  } catch (const tega::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("checkpoint.safetensors: was trained in an earlier UV layout"),
+              std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("retrain the run"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(warnings_of_loading(before, tiny.dataset), "");
+
+  const auto since = write_run(tiny, {{kUvLayoutMetadataKey, kUvLayoutChartsApartPacked}});
+  EXPECT_EQ(warnings_of_loading(since, two_tiles), "");
 }
 
 }  // namespace

@@ -19,6 +19,7 @@
 #include "tega/core/dataset.h"
 #include "tega/nn/expression_network.h"
 #include "tega/nn/uv_raster.h"
+#include "tega/trainer/checkpoint.h"
 #include "tega/trainer/gaussians.h"
 #include "tega/trainer/options.h"
 #include "tega/uvd/uvd_map.h"
@@ -63,8 +64,9 @@ class AvatarModel {
   Gaussians gaussians;
   nn::ExpressionNetwork network{nullptr};
 
-  // The template's UVs as the Gaussians use them: the eyeballs laid apart
-  // from the face where they share its UV tile (uvd/uv_layout.h).
+  // The template's UVs as the Gaussians and the networks use them: the
+  // eyeballs laid apart from the face where they share its UV tile, and a
+  // multi-tile layout packed into the unit square (uvd/uv_layout.h).
   const Mesh& uv_layout() const { return uv_layout_; }
   const uvd::UvTriangleLookup& lookup() const { return lookup_; }
   double metres_per_uv() const { return metres_per_uv_; }
@@ -86,5 +88,12 @@ class AvatarModel {
 
 // sqrt(world area / UV area) of a mesh's triangles: metres per unit of uv.
 double metres_per_uv(const Mesh& mesh);
+
+// Throws tega::Error naming `file` when the checkpoint's TeGA Gaussians were
+// trained in an earlier layout than model.uv_layout() (no kUvLayoutMetadataKey)
+// and that layout differs from the template's own UVs; rigged Gaussians live
+// in their triangles' frames and pass.
+void check_uv_layout(const Checkpoint& checkpoint, const std::filesystem::path& file, const AvatarModel& model,
+                     const Mesh& template_mesh, bool rigged);
 
 }  // namespace tega::trainer

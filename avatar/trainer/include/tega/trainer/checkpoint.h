@@ -19,6 +19,10 @@ namespace tega::trainer {
 // texture without the eyeball triangles (docs/training.md#the-encoders-blind-spot).
 inline constexpr const char* kTextureMetadataKey = "displacement_texture";
 inline constexpr const char* kTextureWithoutEyeballs = "without eyeballs";
+// Metadata key and value that say the Gaussians' uv lie in the layout that
+// AvatarModel derives now (docs/uvd-rigging.md#multi-tile-layouts-packed-into-the-unit-square).
+inline constexpr const char* kUvLayoutMetadataKey = "uv_layout";
+inline constexpr const char* kUvLayoutChartsApartPacked = "charts apart, packed into the unit square";
 
 struct Checkpoint {
   std::map<std::string, at::Tensor> tensors;
