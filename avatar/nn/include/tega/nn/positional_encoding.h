@@ -12,8 +12,9 @@ namespace tega::nn {
 
 // PE(uvd) = [x, sin(2^k π x), cos(2^k π x)] for k = 0..frequencies-1, where
 // x = (u, v, depth_scale·d) with d in metres. depth_scale maps d to units
-// comparable with uv (1 unit of u spans roughly 0.3 m of face, so the
-// default 3 makes 1 unit of scaled d ≈ 0.33 m).
+// comparable with uv (the layout fills the unit square, so 1 unit of u spans
+// some tenths of a metre of the head: the default 3 makes 1 unit of scaled
+// d ≈ 0.33 m).
 //
 // Channel 3f + a is feature f (x, then sin and cos per octave) of axis a, so
 // every channel depends on one axis only: its derivative is a single number,
