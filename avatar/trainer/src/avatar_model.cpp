@@ -165,7 +165,10 @@ PosedGaussians AvatarModel::pose(const FrameInput& frame, const Phase& phase) {
 void check_uv_layout(const Checkpoint& checkpoint, const std::filesystem::path& file, const AvatarModel& model,
                      const Mesh& template_mesh, bool rigged) {
   const Mesh& layout = model.uv_layout();
-  const bool as_the_template = layout.uvs == template_mesh.uvs && layout.uv_faces == template_mesh.uv_faces;
+  // Eigen's == needs equal sizes; laying a part apart appends UV entries.
+  const bool as_the_template = layout.uvs.rows() == template_mesh.uvs.rows() &&
+                               layout.uv_faces.rows() == template_mesh.uv_faces.rows() &&
+                               layout.uvs == template_mesh.uvs && layout.uv_faces == template_mesh.uv_faces;
   if (rigged || as_the_template || checkpoint.metadata.count(kUvLayoutMetadataKey)) return;
   throw Error(file,
               "was trained in an earlier UV layout of this template (before its overlapping charts were laid apart "
