@@ -46,6 +46,8 @@ TEST(AblationStudy, TrainsEveryRowAndSeedThenTabulatesAndInspectsThem) {
   EXPECT_EQ(names, (std::set<std::string>{"full.s0", "full.s1", "gaussian-avatars.s0", "gaussian-avatars.s1",
                                           "pyramid.s0", "pyramid.s1"}));
   EXPECT_TRUE(std::filesystem::exists(tmp / "study/table-6.md"));  // the curve's first point
+  // Each run evaluated on its own, then merged.
+  EXPECT_EQ(nlohmann::json::parse(read_text_file(tmp / "study/eval-12/pyramid.s1.json")).at("models").size(), 1u);
 
   const std::string table = read_text_file(tmp / "study/table.md");
   EXPECT_NE(table.find("(iteration 12)"), std::string::npos) << table;
@@ -94,6 +96,33 @@ TEST(AblationStudy, GpusAreCudaDeviceIndices) {
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("GPUS: 'cuda:1' is not a CUDA device index"), std::string::npos) << r.output;
   EXPECT_FALSE(std::filesystem::exists(tmp / "study/capture"));
+}
+
+TEST(AblationTable, RefusesFilesEvaluatedDifferentlyOrNamingARunTwice) {
+  TempDir tmp;
+  const auto document = [](const std::string& landmark_note, const std::string& run) {
+    return nlohmann::json{{"format", "tega-eval"},
+                          {"notes", {{"landmark_px", landmark_note}}},
+                          {"models", {{{"name", run}, {"gaussians", 10}, {"splits", nlohmann::json::object()}}}}}
+        .dump();
+  };
+  write_text(tmp / "a.json", document("with a predictor", "full.s0"));
+  write_text(tmp / "b.json", document("with a predictor", "full.s1"));
+  write_text(tmp / "c.json", document("skipped", "full.s2"));
+  write_text(tmp / "d.json", document("with a predictor", "full.s0"));
+  const std::string table = "python3 " + std::string(TEGA_SOURCE_DIR) + "/scripts/ablation-table ";
+  const std::string files = (tmp / "a.json").string() + " " + (tmp / "b.json").string();
+
+  const auto merged = run_command(table + files + " --merged " + (tmp / "ab.json").string());
+  ASSERT_EQ(merged.exit_code, 0) << merged.output;
+  EXPECT_EQ(nlohmann::json::parse(read_text_file(tmp / "ab.json")).at("models").size(), 2u);
+
+  const auto differently = run_command(table + files + " " + (tmp / "c.json").string());
+  EXPECT_NE(differently.exit_code, 0);
+  EXPECT_NE(differently.output.find("evaluated differently"), std::string::npos) << differently.output;
+  const auto twice = run_command(table + files + " " + (tmp / "d.json").string());
+  EXPECT_NE(twice.exit_code, 0);
+  EXPECT_NE(twice.output.find("run 'full.s0' is in both"), std::string::npos) << twice.output;
 }
 
 }  // namespace
