@@ -8,7 +8,6 @@
 #include <thread>
 
 #include "disk_space.h"
-#include "interrupt.h"
 #include "live_status.h"
 #include "preview.h"
 #include "rig_stream.h"
@@ -17,6 +16,7 @@
 #include "tega/capture/take_writer.h"
 #include "tega/core/error.h"
 #include "tega/core/files.h"
+#include "tega/core/interrupt.h"
 #include "tega/core/log.h"
 #include "tega/core/take.h"
 

@@ -63,6 +63,12 @@ void add_train_command(CLI::App& app) {
     }
     if (args->data.empty() || args->out.empty()) throw Error("tega train needs --data and --out");
     const auto s = trainer::train(args->data, args->out, options, {args->resume, args->force, args->stop_at});
+    if (s.interrupted) {
+      std::cerr << "tega train: interrupted after " << s.iterations << " of " << options.iterations
+                << " iterations; checkpoint saved: " << s.checkpoint.string() << "\n(tega train --out " << args->out
+                << " --resume continues)\n";
+      throw CLI::RuntimeError(130);
+    }
     std::cout << "trained " << s.iterations << " iterations in " << s.seconds << " s: " << s.gaussians
               << " Gaussians, loss " << s.final_loss << ", train PSNR " << s.train_psnr << " dB, held-out-camera PSNR "
               << s.heldout_psnr << " dB\ncheckpoint: " << s.checkpoint.string() << "\n";

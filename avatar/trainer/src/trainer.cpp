@@ -18,6 +18,7 @@
 
 #include "tega/core/error.h"
 #include "tega/core/files.h"
+#include "tega/core/interrupt.h"
 #include "tega/core/log.h"
 #include "tega/core/options.h"
 #include "tega/core/progress.h"
@@ -176,7 +177,8 @@ class Run {
       step(view, take);
       ++iteration_;
       if (iteration_ == first + 1) first_done = std::chrono::steady_clock::now();
-      const bool log_due = iteration_ % options_.log_every == 0 || iteration_ == last;
+      const bool interrupted = InterruptGuard::requested();
+      const bool log_due = iteration_ % options_.log_every == 0 || iteration_ == last || interrupted;
       const bool checkpoint_due = iteration_ % options_.checkpoint_every == 0 && iteration_ < last;
       if (log_due || checkpoint_due) take(readout_.pop());
       if (failed) {
@@ -204,6 +206,12 @@ class Run {
         window_loss = window_psnr = 0;
         window = 0;
       }
+      if (interrupted) {
+        logging::warn("interrupted at iteration %lld of %lld: saving a checkpoint (--resume continues)",
+                      static_cast<long long>(iteration_), static_cast<long long>(options_.iterations));
+        summary.interrupted = true;
+        break;
+      }
       if (checkpoint_due) save();
     }
     profiler_.stop();
@@ -212,7 +220,8 @@ class Run {
     summary.iterations = iteration_;
     summary.gaussians = model_.gaussians.size();
     summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    summary.heldout_psnr = heldout_psnr();
+    // An interrupted run (a scheduler's time limit, say) has seconds left, not the held-out renders' time.
+    summary.heldout_psnr = summary.interrupted ? std::numeric_limits<double>::quiet_NaN() : heldout_psnr();
     summary.checkpoint = run_dir_ / kCheckpoint;
     if (profiler_.enabled()) {
       summary.milliseconds_per_step = profiler_.mean_milliseconds(iteration_ - first);
@@ -581,6 +590,7 @@ TrainSummary train(const fs::path& dataset, const fs::path& run, TrainOptions op
 
   // The networks' initial weights come from libtorch's global generator.
   at::manual_seed(static_cast<uint64_t>(options.seed));
+  InterruptGuard interrupt;
   Run training(dataset, run, options, control);
   TrainSummary summary = training.train(control.stop_at);
 
@@ -591,6 +601,7 @@ TrainSummary train(const fs::path& dataset, const fs::path& run, TrainOptions op
                                  {"train_psnr", summary.train_psnr},
                                  {"heldout_psnr", summary.heldout_psnr},
                                  {"seconds", summary.seconds},
+                                 {"interrupted", summary.interrupted},
                                  {"checkpoint", kCheckpoint}};
   write_text_atomic(run / "run.json", report.dump(2));
   return summary;

@@ -2,10 +2,16 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <nlohmann/json.hpp>
 #include <sstream>
+#include <thread>
 
 #include "tega/core/error.h"
 #include "tega/core/files.h"
+#include "tega/core/interrupt.h"
 #include "tega/trainer/checkpoint.h"
 #include "tega/trainer/trainer.h"
 #include "test_support.h"
@@ -85,6 +91,41 @@ TEST(Trainer, ResumeReproducesAnUninterruptedRun) {
   ASSERT_EQ(straight_losses.size(), 6u);
   ASSERT_EQ(sliced_losses.size(), 6u);
   for (size_t i = 0; i < 6; ++i) EXPECT_NEAR(straight_losses[i], sliced_losses[i], 1e-5 * straight_losses[i]) << i;
+}
+
+// SIGTERM (a scheduler's time limit, `tega run` stopping) or Ctrl-C stops a
+// run at the end of a step, with a checkpoint there; resumed, it ends where an
+// uninterrupted run ends.
+TEST(Trainer, ASignalStopsTheRunWithACheckpointThatResumesExactly) {
+  tega::test::TempDir tmp;
+  tega::test::write_tiny_dataset(tmp / "data", /*eyeball=*/false);
+  TrainOptions options = tiny_options();
+  options.iterations = 24;
+  const TrainSummary straight = train(tmp / "data", tmp / "straight", options, {});
+
+  // Should the signal come after the run's own handler is gone, this one takes it.
+  tega::InterruptGuard late_signal;
+  std::thread scheduler([&] {
+    // The run's first checkpoint (iteration 0) is written once its handler is in place.
+    while (!std::filesystem::exists(tmp / "sliced/checkpoint.safetensors"))
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    std::raise(SIGTERM);
+  });
+  const TrainSummary first = train(tmp / "data", tmp / "sliced", options, {});
+  scheduler.join();
+  EXPECT_TRUE(first.interrupted);
+  EXPECT_GE(first.iterations, 1);
+  EXPECT_LT(first.iterations, 24);
+  EXPECT_TRUE(std::isnan(first.heldout_psnr));
+  EXPECT_EQ(read_checkpoint(tmp / "sliced/checkpoint.safetensors").iteration(), first.iterations);
+  const auto report = nlohmann::json::parse(tega::read_text_file(tmp / "sliced/run.json"));
+  EXPECT_EQ(report.at("iterations").get<int64_t>(), first.iterations);
+  EXPECT_TRUE(report.at("interrupted").get<bool>());
+
+  const TrainSummary rest = train(tmp / "data", tmp / "sliced", options, {.resume = true});
+  EXPECT_FALSE(rest.interrupted);
+  EXPECT_EQ(rest.iterations, 24);
+  expect_same_parameters(tmp / "straight", tmp / "sliced");
 }
 
 // A latest checkpoint cut short (a copy interrupted, a disk error): the

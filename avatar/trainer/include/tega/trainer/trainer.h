@@ -6,7 +6,8 @@
 //   RUN/checkpoint.safetensors       the latest checkpoint (atomic)
 //   RUN/checkpoint.previous.safetensors  the one before it, which a resume falls back on
 //   RUN/metrics.csv                  iteration, loss, psnr, gaussians, seconds
-//   RUN/run.json                     dataset, state and the final summary
+//   RUN/run.json                     dataset, state and the final summary (or where an
+//                                    interrupt stopped it)
 
 #include <filesystem>
 #include <map>
@@ -19,6 +20,9 @@ namespace tega::trainer {
 
 struct TrainSummary {
   int64_t iterations = 0;       // completed
+  // SIGINT or SIGTERM stopped the run at a step's end, with a checkpoint
+  // (tega/core/interrupt.h); heldout_psnr is then NaN.
+  bool interrupted = false;
   int64_t gaussians = 0;
   double seconds = 0;           // this invocation's training time
   // The iterations after this invocation's first (which waits for the loader's

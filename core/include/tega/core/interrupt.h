@@ -1,10 +1,11 @@
 #pragma once
-// Ctrl-C (SIGINT) and SIGTERM during a take ask it to stop and finalise; a
-// second Ctrl-C is not caught, so an operator can still kill a stuck process.
-#include <atomic>
+// Ctrl-C (SIGINT) and SIGTERM (a scheduler's time limit, `tega run` stopping)
+// ask long work to stop at a safe point and keep what it has: a take is
+// finalised, a training run saves a checkpoint. A second signal is not caught,
+// so an operator can still kill a stuck process.
 #include <csignal>
 
-namespace tega::capture {
+namespace tega {
 
 class InterruptGuard {
  public:
@@ -18,4 +19,4 @@ class InterruptGuard {
   struct sigaction previous_int_ {}, previous_term_ {};
 };
 
-}  // namespace tega::capture
+}  // namespace tega

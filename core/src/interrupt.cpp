@@ -1,6 +1,6 @@
-#include "interrupt.h"
+#include "tega/core/interrupt.h"
 
-namespace tega::capture {
+namespace tega {
 
 namespace {
 volatile std::sig_atomic_t interrupted = 0;
@@ -24,4 +24,4 @@ InterruptGuard::~InterruptGuard() {
 
 bool InterruptGuard::requested() { return interrupted != 0; }
 
-}  // namespace tega::capture
+}  // namespace tega
