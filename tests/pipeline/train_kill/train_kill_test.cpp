@@ -1,6 +1,7 @@
 // Kill -9 `tega run` while its train shard trains, then run it again: the
 // shard resumes from its last checkpoint (never from iteration 0) and ends
-// with the parameters of an uninterrupted run.
+// with the parameters of an uninterrupted run. Stopped by SIGTERM instead,
+// the shard saves the step it was at and resumes from there.
 
 #include <ATen/ATen.h>
 #include <gtest/gtest.h>
@@ -26,12 +27,14 @@ constexpr int kTrials = 10;
 constexpr int kIterations = 200;
 
 // The virtual studio's tiniest capture and a training run of a few seconds
-// on one CPU thread (deterministic), checkpointing every 10 iterations.
-std::string config_text() {
+// on one CPU thread (deterministic), checkpointing every `checkpoint_every`
+// iterations.
+std::string config_text(int checkpoint_every = 10) {
   return "workspace: unused\nstages:\n  synth:\n    options:\n" + tiny_synth_options(6) +
          "  train:\n    after: [synth]\n    options:\n"
          "      device: cpu\n      cpu_threads: 1\n      loader_threads: 1\n      prefetch: 2\n"
-         "      iterations: " + std::to_string(kIterations) + "\n      checkpoint_every: 10\n      log_every: 1\n"
+         "      iterations: " + std::to_string(kIterations) + "\n      checkpoint_every: " +
+         std::to_string(checkpoint_every) + "\n      log_every: 1\n"
          "      initial_gaussians: 64\n      warmup: 0.25\n"
          "      densify: {start: 0.0, stop: 1.0, interval: 0.25, gradient_threshold: 0.0}\n"
          "      loss: {smoothness_samples: 32}\n"
@@ -45,20 +48,27 @@ std::vector<std::string> run_args(const fs::path& config, const fs::path& worksp
 
 fs::path committed_run(const fs::path& workspace) { return workspace / "train" / "default" / "run"; }
 
+// The checkpoint in the train shard's staging directory, or an empty path.
+fs::path staged_checkpoint(const fs::path& workspace) {
+  if (!fs::exists(workspace / "train")) return {};
+  for (const auto& entry : fs::directory_iterator(workspace / "train")) {
+    const fs::path checkpoint = entry.path() / "run" / "checkpoint.safetensors";
+    if (entry.path().filename().string().find("staging") != std::string::npos && fs::exists(checkpoint))
+      return checkpoint;
+  }
+  return {};
+}
+
 // The iteration of the checkpoint a killed shard left in its staging
 // directory, or 0 where it left none that can be read.
 int64_t staged_iteration(const fs::path& workspace) {
-  if (!fs::exists(workspace / "train")) return 0;
-  for (const auto& entry : fs::directory_iterator(workspace / "train")) {
-    const fs::path checkpoint = entry.path() / "run" / "checkpoint.safetensors";
-    if (entry.path().filename().string().find("staging") == std::string::npos || !fs::exists(checkpoint)) continue;
-    try {
-      return trainer::read_checkpoint(checkpoint).iteration();
-    } catch (const Error&) {
-      return 0;
-    }
+  const fs::path checkpoint = staged_checkpoint(workspace);
+  if (checkpoint.empty()) return 0;
+  try {
+    return trainer::read_checkpoint(checkpoint).iteration();
+  } catch (const Error&) {
+    return 0;
   }
-  return 0;
 }
 
 void expect_same_parameters(const fs::path& a_run, const fs::path& b_run) {
@@ -133,6 +143,50 @@ TEST(KillNineTraining, AKilledTrainShardResumesFromItsCheckpoint) {
   EXPECT_GE(resumed_from_a_checkpoint, kTrials / 2);
   std::printf("%d of %d trials resumed from a checkpoint; the others had none yet or had finished\n",
               resumed_from_a_checkpoint, kTrials);
+}
+
+// SIGTERM to `tega run` (Ctrl-C, a scheduler's time limit): the train shard
+// stops at the end of its step with a checkpoint there, where its periodic
+// checkpoints would have lost every step since iteration 0 here; started
+// again, it goes on from that step and ends where an uninterrupted run ends.
+TEST(TerminatedTraining, AStoppedTrainShardSavesTheStepItWasAtAndResumesThere) {
+  if (!tega_has_command({"synth"}) || !tega_has_command({"train"})) GTEST_SKIP() << "this build has no synth or train";
+  TempDir dir;
+  write_text(dir / "p.yaml", config_text(/*checkpoint_every=*/100000));
+  const fs::path config = dir / "p.yaml";
+  for (const char* ws : {"reference", "stopped"}) {
+    ASSERT_EQ(run_tega({"run", config.string(), "--workspace", (dir / ws).string(), "--only", "synth"}, dir.path())
+                  .exit_code,
+              0);
+  }
+  const auto start = Clock::now();
+  const auto reference = run_tega(run_args(config, dir / "reference"), dir.path());
+  const double train_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  ASSERT_EQ(reference.exit_code, 0) << reference.output;
+
+  const fs::path ws = dir / "stopped";
+  const pid_t run = spawn_tega(run_args(config, ws), dir / "stopped-output.txt");
+  ASSERT_GT(run, 0);
+  // The first checkpoint (iteration 0) is on disk once the shard trains.
+  const auto launched = Clock::now();
+  while (staged_checkpoint(ws).empty() && Clock::now() - launched < std::chrono::duration<double>(2 * train_seconds))
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  std::this_thread::sleep_for(std::chrono::duration<double>(0.3 * train_seconds));
+  ::kill(run, SIGTERM);
+  EXPECT_EQ(wait_for_exit(run), 130) << read_text_file(dir / "stopped-output.txt");
+  const int64_t stopped_at = staged_iteration(ws);
+  ASSERT_GT(stopped_at, 0) << "no step saved; output:\n" << read_text_file(dir / "stopped-output.txt");
+  ASSERT_LT(stopped_at, kIterations);
+  const fs::path log = ws / "logs" / "train" / "default.log";
+  EXPECT_NE(read_text_file(log).find("interrupted at iteration " + std::to_string(stopped_at)), std::string::npos)
+      << read_text_file(log);
+
+  const auto resumed = run_tega(run_args(config, ws), dir.path());
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  EXPECT_TRUE(std::regex_search(read_text_file(log),
+                                std::regex("resumed .*checkpoint.*at iteration " + std::to_string(stopped_at))))
+      << read_text_file(log);
+  expect_same_parameters(committed_run(dir / "reference"), committed_run(ws));
 }
 
 }  // namespace
