@@ -38,16 +38,20 @@ at::Tensor to_tensor(const Eigen::Matrix3d& m, const at::Device& device) {
   return at::from_blob(const_cast<float*>(f.data()), {3, 3}, at::kFloat).to(device, false, true);
 }
 
+// [F] bool on the CPU: the eyeballs' triangles.
+at::Tensor eyeball_face_mask(const Dataset& dataset) {
+  at::Tensor mask = at::zeros({dataset.template_mesh.num_faces()}, at::TensorOptions(at::kBool));
+  auto eyeball = mask.accessor<bool, 1>();
+  for (const int32_t f : dataset.eyeball_faces) eyeball[f] = true;  // read_dataset checked the range
+  return mask;
+}
+
 // The triangles the field moves: all but the eyeballs. The displacement
 // texture draws only these, since the rigid eyeballs tell nothing of the
 // expression and would take texels from it.
-std::vector<int32_t> deformable_faces(const Dataset& dataset) {
-  std::vector<bool> eyeball(dataset.template_mesh.num_faces(), false);
-  for (const int32_t f : dataset.eyeball_faces) eyeball.at(f) = true;  // read_dataset checked the range
-  std::vector<int32_t> faces;
-  for (int32_t f = 0; f < dataset.template_mesh.num_faces(); ++f)
-    if (!eyeball[f]) faces.push_back(f);
-  return faces;
+std::vector<int32_t> deformable_faces(const at::Tensor& eyeball_face_mask) {
+  const at::Tensor faces = eyeball_face_mask.logical_not().nonzero().view(-1).to(at::kInt).contiguous();
+  return {faces.data_ptr<int32_t>(), faces.data_ptr<int32_t>() + faces.numel()};
 }
 
 // [length, Gaussian, triangle, u, v] of the longest row of `moves` [N,3].
@@ -64,11 +68,11 @@ AvatarModel::AvatarModel(const Dataset& dataset, const TrainOptions& options, co
     : device_(device),
       uv_layout_(uvd::packed_in_unit_square(uvd::with_part_laid_apart(dataset.template_mesh, dataset.eyeball_faces))),
       lookup_(uvd::UvTriangleLookup(uv_layout_, options.uv_lookup).to(device)),
-      uv_rasterizer_(nn::UvRasterizer(uv_layout_, options.network.texture_size, deformable_faces(dataset)).to(device)),
+      eyeball_face_mask_(eyeball_face_mask(dataset)),
+      uv_rasterizer_(nn::UvRasterizer(uv_layout_, options.network.texture_size, deformable_faces(eyeball_face_mask_))
+                         .to(device)),
       template_vertices_(to_tensor(dataset.template_mesh.positions, device)),
       metres_per_uv_(trainer::metres_per_uv(uv_layout_)) {
-  eyeball_face_mask_ = at::zeros({dataset.template_mesh.num_faces()}, at::TensorOptions(at::kBool));
-  for (int32_t f : dataset.eyeball_faces) eyeball_face_mask_[f] = true;
   eyeball_face_mask_ = eyeball_face_mask_.to(device);
   network = nn::ExpressionNetwork(options.network);
   network->to(device);

@@ -79,9 +79,9 @@ class AvatarModel {
   at::Device device_;
   Mesh uv_layout_;
   uvd::UvTriangleLookup lookup_;
+  at::Tensor eyeball_face_mask_;  // [F] bool; before uv_rasterizer_, which is built from it
   nn::UvRasterizer uv_rasterizer_;
   at::Tensor template_vertices_;  // [V,3] head space
-  at::Tensor eyeball_face_mask_;  // [F] bool
   double metres_per_uv_ = 1.0;
   double mean_triangle_scale_ = 1.0;
 };
