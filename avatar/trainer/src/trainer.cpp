@@ -47,6 +47,10 @@ constexpr const char* kCheckpoint = "checkpoint.safetensors";
 constexpr const char* kPreviousCheckpoint = "checkpoint.previous.safetensors";
 constexpr const char* kOptions = "options.yaml";
 constexpr const char* kMetrics = "metrics.csv";
+// Training frames below which the run warns: with 10 expressions the field of
+// the virtual-studio studies learnt them by heart, with 30 it generalised
+// (docs/training.md, "How many expressions the deformation field needs").
+constexpr size_t kExpressionsTheFieldNeeds = 30;
 
 struct MetricRow {
   int64_t iteration;
@@ -141,6 +145,13 @@ class Run {
     logging::info("dataset %s: %zu frames, %zu cameras; %zu training views, template %d vertices; %lld Gaussians",
                   dataset_dir.c_str(), dataset_.frames.size(), dataset_.rig.cameras.size(), train_views_.size(),
                   dataset_.template_mesh.num_vertices(), static_cast<long long>(model_.gaussians.size()));
+    if (options_.deformation_field && dataset_.train.frames.size() < kExpressionsTheFieldNeeds)
+      logging::warn(
+          "dataset %s: %zu training frame%s: the deformation field may learn their expressions by heart and break "
+          "on new ones; on the virtual studio it needed about %zu (docs/training.md#how-many-expressions-the-"
+          "deformation-field-needs)",
+          dataset_dir.c_str(), dataset_.train.frames.size(), dataset_.train.frames.size() == 1 ? "" : "s",
+          kExpressionsTheFieldNeeds);
     if (!dataset_.missing_images.empty())
       logging::warn("dataset %s: %zu images are missing (dataset.json: missing_images); training skips them",
                     dataset_dir.c_str(), dataset_.missing_images.size());

@@ -12,6 +12,7 @@
 #include "tega/core/error.h"
 #include "tega/core/files.h"
 #include "tega/core/interrupt.h"
+#include "tega/core/log.h"
 #include "tega/trainer/checkpoint.h"
 #include "tega/trainer/trainer.h"
 #include "test_support.h"
@@ -300,6 +301,31 @@ TEST(Trainer, TheGaussianCapBoundsTheInitialSampleToo) {
   EXPECT_EQ(first.gaussians, 40);
   const TrainSummary last = train(tmp / "data", tmp / "run", options, {.resume = true});
   EXPECT_LE(last.gaussians, 40);
+}
+
+// A deformation field trained on a few expressions learns them by heart: the
+// run says so, and not when there is no field to mislead.
+TEST(Trainer, TrainingTheFieldOnFewExpressionsWarns) {
+  tega::test::TempDir tmp;
+  tega::test::write_tiny_dataset(tmp / "data", /*eyeball=*/false);
+  const auto warnings = [&](const TrainOptions& options, const std::string& run) {
+    tega::init_logging(0);
+    testing::internal::CaptureStderr();
+    train(tmp / "data", tmp / run, options, {.stop_at = 1});
+    const std::string captured = testing::internal::GetCapturedStderr();
+    tega::init_logging(1);
+    return captured;
+  };
+  const std::string with_field = warnings(tiny_options(), "field");
+  EXPECT_NE(with_field.find("1 training frame: the deformation field may learn their expressions by heart"),
+            std::string::npos)
+      << with_field;
+  EXPECT_NE(with_field.find("docs/training.md#how-many-expressions-the-deformation-field-needs"), std::string::npos);
+
+  TrainOptions no_warp = tiny_options();
+  no_warp.deformation_field = false;
+  const std::string without_field = warnings(no_warp, "no-warp");
+  EXPECT_EQ(without_field.find("deformation field"), std::string::npos) << without_field;
 }
 
 TEST(Trainer, BadDatasetFailsBeforeTraining) {
