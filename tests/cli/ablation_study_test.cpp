@@ -1,7 +1,7 @@
 // scripts/ablation-study end to end on a tiny CPU study: a capture of the
 // procedural head, two of the paper's rows and one row of the user's own
 // (ROWS_FILE), two seeds, a curve of two points (so every run resumes once), the
-// table over seeds and the liveness of each row against the true meshes.
+// table over seeds and the liveness of each run against the true meshes.
 
 #include <gtest/gtest.h>
 
@@ -65,10 +65,21 @@ TEST(AblationStudy, TrainsEveryRowAndSeedThenTabulatesAndInspectsThem) {
   EXPECT_NE(read_text_file(tmp / "study/runs/pyramid.s1/options.yaml").find("pyramid_l1: 1"), std::string::npos);
   EXPECT_NE(read_text_file(tmp / "study/runs/full.s1/options.yaml").find("pyramid_l1: 0"), std::string::npos);
 
+  // Every run inspected on its own, then merged in the table's order.
   const std::string liveness = read_text_file(tmp / "study/liveness.md");
-  for (const char* run : {"## full.s0", "## gaussian-avatars.s0", "## pyramid.s0"})
-    EXPECT_NE(liveness.find(run), std::string::npos) << run << "\n" << liveness;
+  std::size_t previous = 0;
+  for (const char* run : {"## full.s0", "## full.s1", "## gaussian-avatars.s0", "## gaussian-avatars.s1",
+                          "## pyramid.s0", "## pyramid.s1"}) {
+    const std::size_t at = liveness.find(run);
+    ASSERT_NE(at, std::string::npos) << run << "\n" << liveness;
+    EXPECT_GT(at, previous) << run << "\n" << liveness;
+    previous = at;
+  }
+  EXPECT_EQ(liveness.find("# Liveness of each part"), liveness.rfind("# Liveness of each part")) << liveness;
   EXPECT_NE(liveness.find("against the true meshes"), std::string::npos) << liveness;
+  const nlohmann::json inspected = nlohmann::json::parse(read_text_file(tmp / "study/liveness.json"));
+  ASSERT_EQ(inspected.size(), 6u);
+  EXPECT_EQ(inspected.at(1).at("run").get<std::string>(), (tmp / "study/runs/full.s1").string());
 }
 
 TEST(AblationStudy, ARowOfTheRowsFileMustBeNewAndWellNamed) {
