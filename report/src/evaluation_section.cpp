@@ -19,7 +19,7 @@ const MetricColumns kMetrics = {
     {"psnr", 2},      {"ssim", 4},           {"l1", 4},
     {"lpips", 4},     {"psnr_masked", 2},    {"ssim_masked", 4},
     {"l1_masked", 4}, {"hf_psnr_masked", 2}, {"gradient_error_masked", 4},
-    {"landmark_px", 2}, {"landmark_drift_px", 2}};
+    {"psnr_background", 2}, {"landmark_px", 2}, {"landmark_drift_px", 2}};
 
 // Inside the head mask, in boxes around the eyes and the mouth: a table of their own.
 const MetricColumns kCloseupMetrics = {

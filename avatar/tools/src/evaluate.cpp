@@ -24,7 +24,8 @@ const std::vector<std::string>& metric_names() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> out{"landmark_px",    "landmark_drift_px", "lpips",       "ssim",
                                  "psnr",           "l1",                "ssim_masked", "psnr_masked",
-                                 "l1_masked",      "hf_psnr_masked",    "gradient_error_masked"};
+                                 "l1_masked",      "hf_psnr_masked",    "gradient_error_masked",
+                                 "psnr_background"};
     out.insert(out.end(), closeup_metric_names().begin(), closeup_metric_names().end());
     return out;
   }();
@@ -107,6 +108,7 @@ std::vector<SplitResult> evaluate_avatar(trainer::TrainedAvatar& avatar, const D
       v.metrics["l1_masked"] = l1(rendered, target, mask);
       v.metrics["hf_psnr_masked"] = head.hf_psnr;
       v.metrics["gradient_error_masked"] = head.gradient_error;
+      v.metrics["psnr_background"] = psnr(rendered, target, mask.logical_not());
       if (lpips_here) v.metrics["lpips"] = (*lpips_here)(rendered, target);
       if (landmarks) v.metrics["landmark_drift_px"] = landmark_drift_px(reference_landmarks, avatar_landmarks, camera);
       if (markup) {
@@ -170,6 +172,11 @@ const char* const kDetailNote =
     "pixel). Both inside the head mask: they score the fine detail (wrinkles, hair, sharp edges) that LPIPS and "
     "close-ups show and PSNR barely weighs";
 
+const char* const kBackgroundNote =
+    "psnr_background: PSNR (peak 1) outside the head mask (alpha <= 0.5), where the truth shows only the "
+    "background: what a model draws there (floaters, haze, a silhouette grown too wide) counts here and barely "
+    "in the masked metrics; NaN for a view whose matte is opaque everywhere";
+
 nlohmann::json number(double v) {
   if (std::isnan(v)) return "nan";
   if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
@@ -216,7 +223,8 @@ MetricColumn metric_column(const std::string& metric) {
       {"ssim", {"SSIM ↑", 3}},                {"psnr", {"PSNR ↑", 2}},
       {"l1", {"L1 ↓", 4}},                    {"ssim_masked", {"SSIM ↑", 3}},
       {"psnr_masked", {"PSNR ↑", 2}},         {"l1_masked", {"L1 ↓", 4}},
-      {"hf_psnr_masked", {"HF PSNR ↑", 2}},   {"gradient_error_masked", {"Gradient error ↓", 4}}};
+      {"hf_psnr_masked", {"HF PSNR ↑", 2}},   {"gradient_error_masked", {"Gradient error ↓", 4}},
+      {"psnr_background", {"PSNR ↑", 2}}};
   if (const auto it = columns.find(metric); it != columns.end()) return it->second;
   // closeup_<region>_<metric>: the region's table titles its columns as the masked metric's.
   for (const CloseupRegion& region : closeup_regions()) {
@@ -280,6 +288,7 @@ nlohmann::json evaluation_json(const std::vector<ModelResult>& models, const Eva
                   {"landmark_drift_px", notes.landmark_drift_px},
                   {"closeups", notes.closeups},
                   {"masked", "*_masked metrics are computed inside the head mask: the dataset image's alpha > 0.5"},
+                  {"background", kBackgroundNote},
                   {"detail", kDetailNote},
                   {"statistics", "mean and population standard deviation over views; NaN values (an empty mask) are "
                                  "counted under 'undefined' and left out"}};
@@ -313,6 +322,8 @@ std::string evaluation_markdown(const std::vector<ModelResult>& models, const Ev
   out += table(models, {"landmark_px", "landmark_drift_px", "lpips", "ssim", "psnr", "l1"});
   out += "\n## Inside the head mask (alpha > 0.5)\n\n";
   out += table(models, {"ssim_masked", "psnr_masked", "l1_masked", "hf_psnr_masked", "gradient_error_masked"});
+  out += "\n## Outside the head mask (alpha <= 0.5): the background\n\n";
+  out += table(models, {"psnr_background"});
   for (const CloseupRegion& region : closeup_regions()) {
     const std::string prefix = "closeup_" + region.name + "_";
     out += "\n## Close-up: " + region.name + ", inside the head mask (" + prefix + "*)\n\n";
@@ -324,6 +335,7 @@ std::string evaluation_markdown(const std::vector<ModelResult>& models, const Ev
   out += "- " + notes.landmark_drift_px + "\n";
   out += "- " + notes.closeups + "\n";
   out += std::string("- ") + kDetailNote + "\n";
+  out += std::string("- ") + kBackgroundNote + "\n";
   return out;
 }
 

@@ -59,11 +59,49 @@ TEST(Eval, ScoresTheViewsOfThePapersProtocol) {
     EXPECT_GT(v.metrics.at("gradient_error_masked"), 0.0);
     // The tiny dataset's matte is opaque everywhere: masked = full.
     EXPECT_NEAR(v.metrics.at("psnr_masked"), v.metrics.at("psnr"), 1e-9);
+    EXPECT_TRUE(std::isnan(v.metrics.at("psnr_background")));  // no background pixel
     EXPECT_EQ(v.metrics.count("lpips"), 0u);
     EXPECT_EQ(v.metrics.count("landmark_px"), 0u);
     EXPECT_EQ(v.metrics.count("landmark_drift_px"), 0u);
     EXPECT_EQ(v.metrics.count("closeup_mouth_psnr"), 0u);
   }
+}
+
+// The head mask and the background split every view's pixels: the full image's
+// squared error is their area-weighted sum, so a render's error lands in one or
+// the other, never in both and never lost.
+TEST(Eval, BackgroundPsnrScoresWhatLiesOutsideTheHeadMask) {
+  test::TinyAvatar tiny;
+  const std::string camera = "cam01", frame = "smile_000000";  // the novel view
+  Image8 image = read_image_u8(tiny.dataset.image_path(camera, frame));
+  ASSERT_EQ(image.channels, 4);
+  const int head_columns = image.width / 3;  // the matte: opaque in the left third only
+  for (int y = 0; y < image.height; ++y)
+    for (int x = head_columns; x < image.width; ++x) image.at(x, y, 3) = 0;
+  write_image(image, tiny.dataset.image_path(camera, frame));
+
+  const std::vector<SplitResult> splits = evaluate_avatar(*tiny.avatar, tiny.dataset, "test", nullptr);
+  const ViewResult& v = splits[1].views[0];
+  ASSERT_EQ(v.camera, camera);
+  const at::Tensor background = at::tensor(tiny.avatar->options.background, at::kFloat);
+  at::NoGradGuard no_grad;
+  const trainer::FrameInput input =
+      tiny.model().frame_input(tiny.dataset.load_mesh(frame), tiny.dataset.frame(frame).head_to_world);
+  const at::Tensor rendered = trainer::render_view(tiny.model(), input, tiny.dataset.rig.camera(camera),
+                                                   tiny.avatar->phase, background, false)
+                                  .clamp(0, 1);
+  const at::Tensor target = trainer::composite_target(dataset_image(tiny.dataset, camera, frame), background);
+  at::Tensor outside = at::ones({image.height, image.width}, at::kBool);
+  outside.narrow(1, 0, head_columns).fill_(false);
+  EXPECT_NEAR(v.metrics.at("psnr_background"), psnr(rendered, target, outside), 1e-9);
+  EXPECT_NEAR(v.metrics.at("psnr_masked"), psnr(rendered, target, outside.logical_not()), 1e-9);
+  const auto mse = [](double psnr_db) { return std::pow(10.0, -psnr_db / 10); };
+  const double head_share = static_cast<double>(head_columns) / image.width;
+  EXPECT_NEAR(mse(v.metrics.at("psnr")),
+              head_share * mse(v.metrics.at("psnr_masked")) + (1 - head_share) * mse(v.metrics.at("psnr_background")),
+              1e-6 * mse(v.metrics.at("psnr")));
+  // Where the truth is the background, the Gaussians the avatar draws there are the error.
+  EXPECT_TRUE(std::isfinite(v.metrics.at("psnr_background")));
 }
 
 TEST(Eval, LandmarkDriftFollowsTheDeformationField) {
@@ -202,6 +240,9 @@ TEST(Eval, JsonAndMarkdownHoldStatisticsNotesAndInfinity) {
                 model.splits[1].views[0].metrics.at(detail), 1e-9);
     EXPECT_NE(doc["notes"]["detail"].get<std::string>().find(detail), std::string::npos);
   }
+  // The tiny dataset's matte is opaque: no view has a background pixel to score.
+  EXPECT_EQ(ours["novel_view"]["metrics"]["psnr_background"]["undefined"].get<int>(), 1);
+  EXPECT_NE(doc["notes"]["background"].get<std::string>().find("psnr_background"), std::string::npos);
   const auto& perfect_json = doc["models"][1]["splits"]["reenactment"]["metrics"];
   EXPECT_EQ(perfect_json["psnr"]["mean"], "inf");
   EXPECT_EQ(perfect_json["psnr"]["std"], "nan");
@@ -214,6 +255,7 @@ TEST(Eval, JsonAndMarkdownHoldStatisticsNotesAndInfinity) {
   EXPECT_NE(markdown.find("Novel view SSIM ↑"), std::string::npos) << markdown;
   EXPECT_NE(markdown.find("Test reenactment HF PSNR ↑"), std::string::npos) << markdown;
   EXPECT_NE(markdown.find("Novel view Gradient error ↓"), std::string::npos) << markdown;
+  EXPECT_NE(markdown.find("## Outside the head mask"), std::string::npos) << markdown;
   EXPECT_NE(markdown.find("∞ ± nan"), std::string::npos) << markdown;
   char psnr_text[32];
   std::snprintf(psnr_text, sizeof psnr_text, "%.2f ± 0.00", psnr_value);
