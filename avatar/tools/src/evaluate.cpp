@@ -108,7 +108,7 @@ std::vector<SplitResult> evaluate_avatar(trainer::TrainedAvatar& avatar, const D
       v.metrics["l1_masked"] = l1(rendered, target, mask);
       v.metrics["hf_psnr_masked"] = head.hf_psnr;
       v.metrics["gradient_error_masked"] = head.gradient_error;
-      v.metrics["psnr_background"] = psnr(rendered, target, mask.logical_not());
+      v.metrics["psnr_background"] = masked_psnr(maps.squared_error, mask.logical_not());
       if (lpips_here) v.metrics["lpips"] = (*lpips_here)(rendered, target);
       if (landmarks) v.metrics["landmark_drift_px"] = landmark_drift_px(reference_landmarks, avatar_landmarks, camera);
       if (markup) {

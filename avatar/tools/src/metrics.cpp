@@ -65,12 +65,12 @@ at::Tensor hf_squared_error_map(const at::Tensor& a, const at::Tensor& b) {
   return high_pass(a.to(at::kDouble) - b.to(at::kDouble)).square().mean(0);
 }
 
+}  // namespace
+
 double masked_psnr(const at::Tensor& squared_error, const at::Tensor& mask) {
   const double mse = masked_mean(squared_error, mask);
   return std::isnan(mse) ? mse : mse_to_psnr(mse);
 }
-
-}  // namespace
 
 double psnr(const at::Tensor& a, const at::Tensor& b) {
   check_pair(a, b);

@@ -63,6 +63,10 @@ struct MaskedMetrics {
 };
 MaskedMetrics masked_metrics(const ErrorMaps& maps, const at::Tensor& mask);
 
+// The PSNR of a squared-error map (ErrorMaps::squared_error) over `mask` [H,W] bool
+// (NaN for an empty mask): eval's background PSNR, outside the head mask.
+double masked_psnr(const at::Tensor& squared_error, const at::Tensor& mask);
+
 // Mean and (population) standard deviation of the finite-or-infinite values
 // given; NaN values (e.g. masked metrics of an empty mask) are left out and
 // counted apart. With an infinite value the mean is infinite and the std NaN.
