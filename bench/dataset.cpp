@@ -19,13 +19,13 @@
 #include "tega/core/mesh.h"
 #include "tega/core/rig.h"
 #include "tega/core/take.h"
+#include "tega/core/take_images.h"
+#include "tega/core/tracked.h"
 #include "tega/matting/dataset_build.h"
 #include "tega/matting/dataset_image.h"
 #include "tega/matting/matte.h"
-#include "tega/matting/recorded_image.h"
+#include "tega/scoring/tracking_scores.h"
 #include "tega/synth/virtual_studio.h"
-#include "tega/tracking/evaluation.h"
-#include "tega/tracking/tracked.h"
 
 
 namespace fs = std::filesystem;
@@ -98,7 +98,7 @@ void stage_table(const fs::path& capture, const Camera& camera, int downsample) 
   const TakeInfo take = read_take(capture / "takes" / "expressions");
   Image8 rgb, matte, small;
   const double read_s = timed(1, [&] {
-    rgb = matting::read_recorded_rgb(take, camera.name, 0, camera.width, camera.height, downsample);
+    rgb = read_recorded_rgb(take, camera.name, 0, camera.width, camera.height, downsample);
   });
   const double matte_s = timed(1, [&] {
     matte = box_downsample(
@@ -115,13 +115,13 @@ void stage_table(const fs::path& capture, const Camera& camera, int downsample) 
 void matte_table(const fs::path& capture, const fs::path& tracked, const Camera& camera) {
   const TakeInfo take = read_take(capture / "takes" / "expressions");
   const TakeInfo plate_take = read_take(capture / "takes" / "clean_plate");
-  const tracking::TrackedSubject subject = tracking::read_tracked_subject(tracked);
-  const tracking::TrackedFrame frame = tracking::read_tracked_take(tracked, "expressions").front();
+  const TrackedSubject subject = read_tracked_subject(tracked);
+  const TrackedFrame frame = read_tracked_take(tracked, "expressions").front();
   Image8 photo, alpha;
   Vertices world;
-  const double read_s = timed(1, [&] { photo = matting::read_recorded_rgb(take, camera.name, frame.frame, camera.width, camera.height); });
+  const double read_s = timed(1, [&] { photo = read_recorded_rgb(take, camera.name, frame.frame, camera.width, camera.height); });
   const double mesh_s = timed(1, [&] { world = read_vertices_bin(frame.mesh, subject.neutral.num_vertices()); });
-  const matting::CameraMatting matting(camera, matting::read_recorded_rgb(plate_take, camera.name, 0, camera.width, camera.height), matting::MatteOptions());
+  const matting::CameraMatting matting(camera, read_recorded_rgb(plate_take, camera.name, 0, camera.width, camera.height), matting::MatteOptions());
   const double matte_s = timed(3, [&] { alpha = matting.matte(photo, world, subject.neutral.faces); });
   const fs::path file = fs::temp_directory_path() / "tega-bench-matte.png";
   const double write_s = timed(3, [&] { matting::write_matte(alpha, file); });
@@ -179,7 +179,7 @@ int main(int argc, char** argv) {
   const fs::path tracked = work / "tracked", mattes = work / "mattes";
   remove_tree(tracked);
   remove_tree(mattes);
-  tracking::write_studio_truth_as_tracked(capture, tracked);
+  scoring::write_studio_truth_as_tracked(capture, tracked);
   const Rig rig = read_rig_json(capture / "rig.json");
   const TakeInfo take = read_take(capture / "takes" / "expressions");
   std::printf("captured images: %s, %dx%d\n", take.pixel_format.c_str(), width, height);
@@ -194,7 +194,7 @@ int main(int argc, char** argv) {
   const auto plate_cost = [&](int size_factor) {
     return timed(1, [&] {
       matting::CameraMatting(matting::recorded_camera_at_dataset_size(first_camera, size_factor),
-                             matting::read_recorded_rgb(plate_take, first_camera.name, 0, first_camera.width,
+                             read_recorded_rgb(plate_take, first_camera.name, 0, first_camera.width,
                                                         first_camera.height, size_factor),
                              matting::MatteOptions());
     });

@@ -25,9 +25,9 @@
 #include "tega/synth/ground_truth_depth.h"
 #include "tega/synth/virtual_studio.h"
 #ifdef TEGA_BENCH_HAVE_SURFACE
-#include "tega/mvs/evaluation.h"
-#include "tega/mvs/studio_truth.h"
 #include "tega/mvs/surface.h"
+#include "tega/scoring/studio_truth.h"
+#include "tega/scoring/surface_scores.h"
 #endif
 #ifdef TEGA_BENCH_HAVE_MVS
 #include "tega/core/options.h"
@@ -98,10 +98,10 @@ void score_depth(const mvs::DepthMap& map, const ImageF& truth, DepthScore& scor
 #ifdef TEGA_BENCH_HAVE_SURFACE
 // The mesh against the frame's true fine mesh, over the face.
 void report_mesh(const Mesh& mesh, const fs::path& root, int frame) {
-  const mvs::StudioTruth truth = mvs::load_studio_truth(root, "expressions", frame);
-  mvs::EvaluationOptions eval;
+  const scoring::StudioTruth truth = scoring::load_studio_truth(root, "expressions", frame);
+  scoring::EvaluationOptions eval;
   eval.tolerances_m = {0.001, 0.002, 0.003};
-  const auto s = mvs::evaluate_surface(mesh, truth.fine, truth.face_region, eval);
+  const auto s = scoring::evaluate_surface(mesh, truth.fine, truth.face_region, eval);
   std::printf("mesh: %d vertices, %d faces; accuracy median %.3f mm, mean %.3f mm, p90 %.3f mm; completeness over the "
               "face %.1f %% at 1 mm, %.1f %% at 2 mm, %.1f %% at 3 mm\n",
               mesh.num_vertices(), mesh.num_faces(), 1000 * s.accuracy_median_m, 1000 * s.accuracy_mean_m,

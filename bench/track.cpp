@@ -14,10 +14,10 @@
 #include "tega/core/rig.h"
 #include "tega/core/take.h"
 #include "tega/core/thread_pool.h"
+#include "tega/landmarks/landmarks.h"
+#include "tega/scoring/tracking_scores.h"
 #include "tega/synth/virtual_studio.h"
-#include "tega/tracking/evaluation.h"
 #include "tega/tracking/head_model.h"
-#include "tega/tracking/landmarks.h"
 #include "tega/tracking/photos.h"
 #include "tega/tracking/tracker.h"
 
@@ -97,8 +97,8 @@ int main(int argc, char** argv) {
   }
 
   const tracking::HeadModel model = tracking::load_head_model(model_dir, options.model_metres_per_unit);
-  const std::unique_ptr<tracking::LandmarkDetector> detector =
-      landmarks.empty() ? nullptr : std::make_unique<tracking::LandmarkDetector>(landmarks);
+  const std::unique_ptr<tega::landmarks::LandmarkDetector> detector =
+      landmarks.empty() ? nullptr : std::make_unique<tega::landmarks::LandmarkDetector>(landmarks);
   const Rig rig = read_rig_json(capture / "rig.json");
   const TakeInfo take = read_take(capture / "takes" / "expressions");
   const Mesh fine_topology = meshes_dir.empty() ? read_obj(capture / "ground_truth" / "head" / "fine_topology.obj") : Mesh{};
@@ -121,7 +121,7 @@ int main(int argc, char** argv) {
               "corrections", "total (s)", "flow points", "flow rms px", "blink (eye covered in the photos)");
   double total = 0;
   int counted = 0;
-  std::vector<tracking::ScoredFrame> scored;
+  std::vector<scoring::ScoredFrame> scored;
   for (int frame = 0; frame < take.frames; ++frame) {
     const Mesh scan = scan_of(capture, meshes_dir, fine_topology, frame);
     const tracking::FrameObservation observation{&scan, photos(frame)};
@@ -129,7 +129,7 @@ int main(int argc, char** argv) {
     const tracking::FrameFit fit = tracker.track(observation);
     const double seconds = seconds_since(start);
     tracker.accept(fit, observation);
-    tracking::ScoredFrame t{frame, fit.vertices, fit.state.head_to_world.R, {}};
+    scoring::ScoredFrame t{frame, fit.vertices, fit.state.head_to_world.R, {}};
     for (size_t k = 0; k < fit.state.expression.size(); ++k)
       t.expression[model.shapes.expression_names[k]] = fit.state.expression[k];
     scored.push_back(std::move(t));
@@ -145,16 +145,16 @@ int main(int argc, char** argv) {
   }
   if (counted) std::printf("mean over frames 1..%d: %.2f s per frame (%d threads)\n", take.frames - 1, total / counted, threads);
   if (fs::exists(capture / "ground_truth")) {
-    const tracking::TakeTruth truth(capture, "expressions");
-    const tracking::TrackScores s = truth.score(scored, &subject.neutral);
+    const scoring::TakeTruth truth(capture, "expressions");
+    const scoring::TrackScores s = truth.score(scored, &subject.neutral);
     std::printf("against the truth: vertex error median %.3f mm, p95 %.3f mm; rotation error median %.3f deg, "
                 "max %.3f deg (the fitted subject is turned %.3f deg from the true one; without that taken out the "
                 "poses are %.3f deg off)\n",
                 1000 * s.vertex_median_m, 1000 * s.vertex_p95_m, s.rotation_median_deg, s.rotation_max_deg,
                 s.subject_rotation_deg, s.pose_rotation_median_deg);
     for (const auto& [name, r] : s.correlation) std::printf("  %-16s r = %.3f\n", name.c_str(), r);
-    for (const tracking::ScoredFrame& frame : scored) {  // which frame a bad median or maximum comes from
-      const tracking::TrackScores f = truth.score({frame}, &subject.neutral);
+    for (const scoring::ScoredFrame& frame : scored) {  // which frame a bad median or maximum comes from
+      const scoring::TrackScores f = truth.score({frame}, &subject.neutral);
       std::printf("  frame %d: vertex error median %.3f mm, p95 %.3f mm; rotation error %.3f deg\n", frame.frame,
                   1000 * f.vertex_median_m, 1000 * f.vertex_p95_m, f.rotation_median_deg);
     }

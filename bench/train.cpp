@@ -21,8 +21,8 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "tega/core/files.h"
 #include "tega/core/error.h"
+#include "tega/core/files.h"
 #include "tega/core/log.h"
 #include "tega/core/options.h"
 #include "tega/trainer/trainer.h"

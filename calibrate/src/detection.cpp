@@ -12,13 +12,14 @@
 #include "aruco_board.h"
 #include "tega/core/error.h"
 #include "tega/core/progress.h"
+#include "tega/core/take_images.h"
 #include "tega/core/thread_pool.h"
 
 namespace tega::calibrate {
 namespace {
 
 // The image in grey; a grey image is wrapped, not copied.
-cv::Mat grey_of(const Image8& image) {
+cv::Mat grey_mat(const Image8& image) {
   const cv::Mat m(image.height, image.width, CV_8UC(image.channels), const_cast<uint8_t*>(image.pixels.data()));
   cv::Mat grey;
   switch (image.channels) {
@@ -139,22 +140,10 @@ class Detector {
   cv::Ptr<cv::aruco::CharucoBoard> charuco_;
 };
 
-// Raw Bayer frames, made grey without moving a pixel. OpenCV names a mosaic
-// by its second row, GenICam by its first.
-cv::Mat grey_of_bayer(const Image8& mosaic, const std::string& pattern) {
-  const int code = pattern == "RG"   ? cv::COLOR_BayerBG2GRAY
-                   : pattern == "BG" ? cv::COLOR_BayerRG2GRAY
-                   : pattern == "GB" ? cv::COLOR_BayerGR2GRAY
-                                     : cv::COLOR_BayerGB2GRAY;
-  cv::Mat grey;
-  cv::cvtColor(grey_of(mosaic), grey, code);
-  return grey;
-}
-
 }  // namespace
 
 BoardView detect_board(const Image8& image, const Board& board, int min_corners) {
-  return Detector(board).detect(grey_of(image), min_corners);
+  return Detector(board).detect(grey_mat(image), min_corners);
 }
 
 std::vector<BoardView> detect_board_in_take(const TakeInfo& take, const Board& board, int threads, int min_corners) {
@@ -162,7 +151,7 @@ std::vector<BoardView> detect_board_in_take(const TakeInfo& take, const Board& b
   for (int c = 0; c < int(take.cameras.size()); ++c)
     for (int f = 0; f < take.frames; ++f)
       if (take.has_image(take.cameras[c], f)) images.emplace_back(c, f);
-  const bool bayer = take.pixel_format.starts_with("Bayer");
+  const bool bayer = is_bayer(take.pixel_format);
 
   const Detector detector(board);
   std::vector<BoardView> views(images.size());
@@ -170,10 +159,10 @@ std::vector<BoardView> detect_board_in_take(const TakeInfo& take, const Board& b
   ThreadPool pool(threads);
   pool.parallel_for(0, int64_t(images.size()), [&](int64_t i) {
     const auto [camera, frame] = images[i];
-    const Image8 image = read_image_u8(take.image_path(take.cameras[camera], frame));
-    const cv::Mat grey =
-        bayer && image.channels == 1 ? grey_of_bayer(image, take.pixel_format.substr(5, 2)) : grey_of(image);
-    views[i] = detector.detect(grey, min_corners);
+    Image8 image = read_image_u8(take.image_path(take.cameras[camera], frame));
+    // Raw Bayer frames, made grey without moving a pixel.
+    if (bayer && image.channels == 1) image = debayer_grey(image, take.pixel_format);
+    views[i] = detector.detect(grey_mat(image), min_corners);
     views[i].camera = camera;
     views[i].frame = frame;
     progress.advance();

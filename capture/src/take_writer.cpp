@@ -6,11 +6,8 @@
 #include "disk_space.h"
 #include "tega/core/error.h"
 #include "tega/core/image.h"
+#include "tega/core/take_images.h"
 #include "tega/core/thread_pool.h"
-
-#ifdef TEGA_HAVE_OPENCV
-#include <opencv2/imgproc.hpp>
-#endif
 
 namespace tega::capture {
 
@@ -19,16 +16,6 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr int kSpaceCheckInterval = 32;  // images between free-space checks
-
-#ifdef TEGA_HAVE_OPENCV
-// OpenCV names a mosaic by its second row; GenICam by its first.
-int demosaic_code(const std::string& genicam_pattern) {
-  if (genicam_pattern == "RG") return cv::COLOR_BayerBG2RGB;
-  if (genicam_pattern == "BG") return cv::COLOR_BayerRG2RGB;
-  if (genicam_pattern == "GB") return cv::COLOR_BayerGR2RGB;
-  return cv::COLOR_BayerGB2RGB;
-}
-#endif
 
 // Holds converted pixels when the camera's buffer cannot be stored as is.
 struct Converted {
@@ -46,16 +33,9 @@ Converted convert(const Frame& frame, const PixelFormatInfo& format, bool debaye
     for (size_t i = 0; i + 2 < out.bytes.size(); i += 3) std::swap(out.bytes[i], out.bytes[i + 2]);
     out.view.data = out.bytes.data();
   } else if (debayer && !format.bayer.empty()) {
-#ifdef TEGA_HAVE_OPENCV
-    const int type = bytes_per_sample == 2 ? CV_16UC1 : CV_8UC1;
-    const cv::Mat mosaic(frame.height, frame.width, type, const_cast<uint8_t*>(frame.pixels));
     out.bytes.resize(size_t(frame.width) * frame.height * 3 * bytes_per_sample);
-    cv::Mat rgb(frame.height, frame.width, bytes_per_sample == 2 ? CV_16UC3 : CV_8UC3, out.bytes.data());
-    cv::demosaicing(mosaic, rgb, demosaic_code(format.bayer));
+    demosaic(frame.pixels, frame.width, frame.height, bytes_per_sample, format.name, out.bytes.data());
     out.view = {out.bytes.data(), frame.width, frame.height, 3, format.bits, size_t(frame.width) * 3 * bytes_per_sample};
-#else
-    throw Error("debayering needs a build with OpenCV");
-#endif
   }
   return out;
 }
@@ -79,11 +59,9 @@ TakeWriter::TakeWriter(fs::path take_folder, std::vector<Camera> cameras, const 
       pool_(std::make_unique<ThreadPool>(options.threads)) {
   if (options_.format == "tiff" && !image_format_supported("x.tif"))
     throw Error("writer.format tiff needs a build with OpenImageIO; use png");
-#ifndef TEGA_HAVE_OPENCV
   for (const auto& c : cameras_)
-    if (options_.debayer && !c.format.bayer.empty())
+    if (options_.debayer && !c.format.bayer.empty() && !demosaicing_available())
       throw Error("writer.debayer needs a build with OpenCV (camera " + c.name + " is " + c.format.name + ")");
-#endif
   for (const auto& c : cameras_) {
     fs::create_directories(folder_ / c.name);
     queued_.push_back(std::make_unique<std::atomic<int>>(0));

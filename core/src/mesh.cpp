@@ -9,6 +9,13 @@
 
 namespace tega {
 
+Vertices transformed(const RigidTransform& transform, const Vertices& vertices) {
+  Vertices out(vertices.rows(), 3);
+  for (Eigen::Index v = 0; v < vertices.rows(); ++v)
+    out.row(v) = transform.apply(vertices.row(v).transpose().cast<double>()).cast<float>().transpose();
+  return out;
+}
+
 namespace {
 
 // Names the first index of `indices` outside [0, count).

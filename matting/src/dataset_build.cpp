@@ -6,9 +6,9 @@
 
 #include "clean_plate.h"
 #include "opencv_threads.h"
-#include "tega/core/downsample.h"
 #include "tega/core/dataset.h"
 #include "tega/core/dataset_gaps.h"
+#include "tega/core/downsample.h"
 #include "tega/core/error.h"
 #include "tega/core/files.h"
 #include "tega/core/image_header.h"
@@ -17,12 +17,12 @@
 #include "tega/core/progress.h"
 #include "tega/core/rig.h"
 #include "tega/core/take.h"
+#include "tega/core/take_images.h"
 #include "tega/core/thread_pool.h"
+#include "tega/core/tracked.h"
 #include "tega/core/undistort.h"
 #include "tega/matting/dataset_image.h"
 #include "tega/matting/matte.h"
-#include "tega/matting/recorded_image.h"
-#include "tega/tracking/tracked.h"
 
 namespace tega::matting {
 namespace fs = std::filesystem;
@@ -59,7 +59,7 @@ std::string frame_name(int frame) {
 // A tracked frame the dataset may take: enough cameras recorded it.
 struct Candidate {
   const TakeInfo* take;
-  tracking::TrackedFrame tracked;
+  TrackedFrame tracked;
   std::string id() const { return take->name + "_" + frame_name(tracked.frame); }
 };
 
@@ -76,7 +76,7 @@ struct Inputs {
   fs::path rig_file;
   Rig rig;  // the capture's cameras, in the rig's order, with their distortion
   std::vector<TakeInfo> takes;
-  tracking::TrackedSubject subject;
+  TrackedSubject subject;
   std::vector<Candidate> candidates;
   std::optional<TakeInfo> clean_plate;  // matting here: the empty studio's take, if any
   std::string fingerprint;  // what the images depend on besides the options: the resume key
@@ -114,7 +114,7 @@ Inputs read_inputs(const DatasetBuildRequest& request, const DatasetBuildOptions
   in.capture = read_capture(request.capture);
   in.rig_file = in.capture.rig_file(request.rig);
   in.rig = capture_rig(in.capture, in.rig_file, options.downsample);
-  in.subject = tracking::read_tracked_subject(request.tracked);
+  in.subject = read_tracked_subject(request.tracked);
   if (!in.subject.neutral.has_uvs())
     throw Error(request.tracked / "identity.json", "names a neutral mesh without UVs; the dataset's template needs them");
 
@@ -139,7 +139,7 @@ Inputs read_inputs(const DatasetBuildRequest& request, const DatasetBuildOptions
         throw Error(mattes_done, "is missing: take " + name + " was not matted to its end (run tega matte)");
       in.fingerprint += name + " mattes: " + read_text_file(mattes_done) + "\n";
     }
-    std::vector<tracking::TrackedFrame> tracked = tracking::read_tracked_take(request.tracked, name);
+    std::vector<TrackedFrame> tracked = read_tracked_take(request.tracked, name);
     in.fingerprint += name + " tracked: " + read_text_file(request.tracked / name / "track.json") + "\n";
     for (auto& frame : tracked) {
       if (!frame.tracked()) continue;

@@ -14,10 +14,10 @@
 #include "tega/core/progress.h"
 #include "tega/core/rig.h"
 #include "tega/core/take.h"
+#include "tega/core/take_images.h"
 #include "tega/core/thread_pool.h"
+#include "tega/core/tracked.h"
 #include "tega/matting/matte.h"
-#include "tega/matting/recorded_image.h"
-#include "tega/tracking/tracked.h"
 
 namespace tega::matting {
 namespace fs = std::filesystem;
@@ -32,7 +32,7 @@ std::string frame_name(int frame) {
 
 struct TakeJob {
   TakeInfo take;
-  std::map<int, tracking::TrackedFrame> frames;
+  std::map<int, TrackedFrame> frames;
   fs::path out;
 };
 
@@ -42,7 +42,7 @@ MatteSummary matte_capture(const MatteRequest& request, const MatteOptions& opti
   const CaptureInfo capture = read_capture(request.capture);
   const fs::path rig_file = capture.rig_file(request.rig);
   const Rig rig = read_rig_json(rig_file);
-  const tracking::TrackedSubject subject = tracking::read_tracked_subject(request.tracked);
+  const TrackedSubject subject = read_tracked_subject(request.tracked);
   const std::optional<TakeInfo> plate_take = clean_plate_take(capture, options);
   const std::string made_with = options_to_yaml(options) + "clean_plate: " + (plate_take ? plate_take->name : "") +
                                 "\ntracked: " + fs::absolute(request.tracked).string() + "\n";
@@ -53,7 +53,7 @@ MatteSummary matte_capture(const MatteRequest& request, const MatteOptions& opti
   int64_t images = 0;
   for (const std::string& name : capture.performance_takes(request.takes, "to matte")) {
     TakeJob job{read_take(capture.root / "takes" / name), {}, request.out / name};
-    for (auto& frame : tracking::read_tracked_take(request.tracked, name)) job.frames[frame.frame] = std::move(frame);
+    for (auto& frame : read_tracked_take(request.tracked, name)) job.frames[frame.frame] = std::move(frame);
     for (int f = 0; f < job.take.frames; ++f)
       if (!job.frames.count(f))
         throw Error(request.tracked / name / (frame_name(f) + ".json"),
@@ -84,7 +84,7 @@ MatteSummary matte_capture(const MatteRequest& request, const MatteOptions& opti
       not_tracked.push_back({{"frame", f}, {"status", frame.status}, {"reason", frame.reason}});
       ++summary.frames_not_tracked;
     }
-    std::vector<const tracking::TrackedFrame*> tracked;
+    std::vector<const TrackedFrame*> tracked;
     for (const auto& [f, frame] : job.frames)
       if (frame.tracked()) tracked.push_back(&frame);
 
@@ -97,7 +97,7 @@ MatteSummary matte_capture(const MatteRequest& request, const MatteOptions& opti
           camera, plate_take ? read_recorded_rgb(*plate_take, camera_name, 0, camera.width, camera.height) : Image8(),
           options);
       pool.parallel_for(0, int64_t(tracked.size()), [&](int64_t i) {
-        const tracking::TrackedFrame& frame = *tracked[size_t(i)];
+        const TrackedFrame& frame = *tracked[size_t(i)];
         const fs::path file = dir / (frame_name(frame.frame) + ".png");
         if (!job.take.has_image(camera_name, frame.frame) || fs::exists(file)) {
           if (fs::exists(file)) ++kept;

@@ -15,7 +15,7 @@
 #include "tega/core/thread_pool.h"
 #include "tega/core/undistort.h"
 #include "tega/mvs/colmap_workspace.h"
-#include "tega/mvs/debayer.h"
+#include "tega/core/take_images.h"
 #include "tega/mvs/frame_pipeline.h"
 #include "tega/mvs/frame_views.h"
 #include "tega/mvs/view_selection.h"
@@ -322,7 +322,7 @@ MvsSummary reconstruct_capture(const MvsRequest& request, const Options& options
   std::map<std::string, Image8> plates;
   if (options.mask.use_clean_plate) {
     if (auto plate = clean_plate_take(capture)) {
-      const FrameLoader plate_loader(*plate, rig, rig_file.string(), debayer);
+      const FrameLoader plate_loader(*plate, rig, rig_file.string());
       for (auto& view : plate_loader.load(0, pool)) plates[view.camera.name] = std::move(view.colour);
     } else {
       logging::info("mvs: the capture has no clean plate; every pixel is searched");
@@ -331,7 +331,7 @@ MvsSummary reconstruct_capture(const MvsRequest& request, const Options& options
   const std::string done_key = options_to_yaml(options) + "# rig\n" + read_text_file(rig_file);
 
   for (const auto& name : takes) {
-    const FrameLoader loader(read_take(capture.root / "takes" / name), rig, rig_file.string(), debayer);
+    const FrameLoader loader(read_take(capture.root / "takes" / name), rig, rig_file.string());
     const TakeInfo& take = loader.take();
     if (take.kind != "performance")
       logging::warn("mvs: take %s is a %s take, not a performance", take.name.c_str(), take.kind.c_str());

@@ -2,9 +2,9 @@
 #include <iostream>
 #include <memory>
 #include <optional>
-#include <sstream>
 
 #include "commands.h"
+#include "stage_options.h"
 #include "tega/calibrate/calibration.h"
 #include "tega/calibrate/report.h"
 #include "tega/core/error.h"
@@ -19,17 +19,15 @@ namespace tega::cli {
 namespace {
 
 struct CalibrateArguments {
-  std::string take, board, out, init, config;
-  bool print_options = false;
+  std::string take, board, out, init;
   int dpi = 300;
   calibrate::CalibrationOptions options;  // defaults, then the flags given
+  StageOptionFlags option_flags;
 };
 
-// The options: defaults, then the --config file's `calibrate` section, then the flags given.
+// The options: defaults, then the --config file's `calibrate` section, then --set, then the flags given.
 calibrate::CalibrationOptions options_of(const CLI::App& cmd, const CalibrateArguments& args) {
-  if (args.config.empty()) return args.options;
-  calibrate::CalibrationOptions options;
-  load_options(options, args.config, "calibrate");
+  auto options = args.option_flags.load<calibrate::CalibrationOptions>();
   const auto& flags = args.options;
   const auto given = [&](const char* flag) { return cmd.get_option(flag)->count() > 0; };
   if (given("--world")) options.world = flags.world;
@@ -105,19 +103,12 @@ void add_calibrate_command(CLI::App& app) {
                 "With --init: solve for the intrinsics too (needs a full calibration take); by default they stay.");
   cmd->add_option("--min-views", o.min_views, "Board views a camera needs for its own intrinsics (default 4).");
   cmd->add_option("--threads", o.threads, "Threads for detection and the solver (default: all).");
-  cmd->add_option("--config", args->config,
-                  "YAML file whose `calibrate` section sets options (see --print-options); flags given win.");
-  cmd->add_flag("--print-options", args->print_options, "Print every calibration option with its default and exit.");
+  args->option_flags.add_to(*cmd, "calibrate", "calibration", "outlier_px=1.5");
   add_board_command(*cmd, args);
   cmd->callback([cmd, args] {
     if (!cmd->get_subcommands().empty()) return;
     args->options = options_of(*cmd, *args);
-    if (args->print_options) {
-      std::cout << "calibrate:\n";
-      std::istringstream yaml(options_to_yaml(args->options));
-      for (std::string line; std::getline(yaml, line);) std::cout << "  " << line << "\n";
-      return;
-    }
+    if (args->option_flags.print_if_asked(args->options)) return;
     if (args->take.empty() || args->board.empty() || args->out.empty())
       throw Error("tega calibrate needs --take, --board and --out");
     if (args->options.world != "camera" && args->options.world != "board")

@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "commands.h"
+#include "stage_options.h"
 #include "tega/capture/recorder.h"
 #include "tega/capture/session.h"
 #include "tega/core/error.h"
@@ -25,13 +26,11 @@ struct CaptureArguments {
 capture::RigConfig load_rig(const CaptureArguments& args) {
   if (args.rig.empty()) throw Error("--rig is required: the rig config (docs/capture.md#the-rig-config)");
   capture::RigConfig rig = capture::load_rig_config(args.rig);
-  for (const auto& kv : args.overrides) {
-    const auto eq = kv.find('=');
-    if (eq == std::string::npos) throw Error("--set " + kv + ": expected key=value");
-    set_option(rig, kv.substr(0, eq), kv.substr(eq + 1));
-    for (auto& camera : rig.cameras)  // a rig-wide setting reaches every camera
-      if (kv.rfind("settings.", 0) == 0) set_option(camera, kv.substr(0, eq), kv.substr(eq + 1));
-  }
+  apply_overrides(rig, args.overrides);
+  std::vector<std::string> rig_wide_settings;  // reach every camera
+  for (const auto& kv : args.overrides)
+    if (kv.rfind("settings.", 0) == 0) rig_wide_settings.push_back(kv);
+  for (auto& camera : rig.cameras) apply_overrides(camera, rig_wide_settings);
   capture::validate_rig_config(rig);
   return rig;
 }

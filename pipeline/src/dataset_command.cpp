@@ -56,9 +56,7 @@ void add_check_command(CLI::App& dataset) {
 #ifdef TEGA_HAVE_MATTING
 struct BuildArguments {
   matting::DatasetBuildRequest request;
-  std::string config;
-  std::vector<std::string> overrides;
-  bool print_options = false;
+  StageOptionFlags options;
 };
 
 void add_build_command(CLI::App& dataset) {
@@ -76,13 +74,11 @@ void add_build_command(CLI::App& dataset) {
                     "Dataset directory to write; appears only once complete (an interrupted run leaves "
                     "OUT.partial/, which the same command continues).");
   build->add_option("--rig", args->request.rig, "Rig file (default: the capture's rig.json).");
-  build->add_option("--config", args->config, "YAML file whose `dataset` section sets options (see --print-options).");
-  build->add_option("--set", args->overrides, "Override one option, e.g. --set frames=100 (repeatable).");
   build->add_flag("--force", args->request.replace_existing, "Replace --out if it already exists.");
-  build->add_flag("--print-options", args->print_options, "Print every dataset option with its default and exit.");
+  args->options.add_to(*build, "dataset", "dataset", "frames=100");
   build->callback([args] {
-    const auto options = load_stage_options<matting::DatasetBuildOptions>(args->config, "dataset", args->overrides);
-    if (args->print_options) return print_stage_options("dataset", options);
+    const auto options = args->options.load<matting::DatasetBuildOptions>();
+    if (args->options.print_if_asked(options)) return;
     const auto& r = args->request;
     if (r.capture.empty() || r.tracked.empty() || r.out.empty())
       throw Error("tega dataset build: --capture, --tracked and --out are required");

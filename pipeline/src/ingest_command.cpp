@@ -3,7 +3,6 @@
 #include <iostream>
 #include <memory>
 #include <optional>
-#include <sstream>
 
 #include "commands.h"
 #include "stage_options.h"
@@ -15,10 +14,11 @@ namespace tega::cli {
 
 namespace {
 struct MultifaceArguments {
-  std::string capture, out, config, template_obj, matte;
-  std::vector<std::string> overrides, cameras, test_cameras, expressions, test_expressions;
+  std::string capture, out, template_obj, matte;
+  std::vector<std::string> cameras, test_cameras, expressions, test_expressions;
   std::optional<int> frames, test_frames, downsample, threads;
-  bool force = false, print_options = false;
+  bool force = false;
+  StageOptionFlags options;
 };
 
 std::string joined(const std::vector<std::string>& names) {
@@ -40,8 +40,7 @@ void add_ingest_command(CLI::App& app) {
       "(docs/multiface.md).");
   cmd->add_option("--capture", args->capture, "Multiface capture directory (holds KRT and frame_list.txt).");
   cmd->add_option("--out", args->out, "Dataset directory to write; appears only once complete.");
-  cmd->add_option("--config", args->config, "YAML file whose `ingest` section sets options (see --print-options).");
-  cmd->add_option("--set", args->overrides, "Override one option, e.g. --set matte_dilation_px=60 (repeatable).");
+  args->options.add_to(*cmd, "ingest", "ingest", "matte_dilation_px=60");
   cmd->add_option("--cameras", args->cameras,
                   "Cameras to use, by KRT name (default: all but those behind or directly above the head).");
   cmd->add_option("--test-cameras", args->test_cameras,
@@ -59,12 +58,9 @@ void add_ingest_command(CLI::App& app) {
   cmd->add_option("--downsample", args->downsample, "Image size divisor: 1 = full size (default), 2 = half.");
   cmd->add_option("--threads", args->threads, "Worker threads (default: one per hardware thread).");
   cmd->add_flag("--force", args->force, "Replace --out if it already exists.");
-  cmd->add_flag("--print-options", args->print_options, "Print every ingest option with its default and exit.");
 
   cmd->callback([args] {
-    ingest::IngestOptions options;
-    if (!args->config.empty()) load_options(options, args->config, "ingest");
-    apply_overrides(options, args->overrides);
+    auto options = args->options.load<ingest::IngestOptions>();
     if (!args->cameras.empty()) options.cameras = args->cameras;
     if (!args->test_cameras.empty()) options.test_cameras = args->test_cameras;
     if (!args->expressions.empty()) options.expressions = args->expressions;
@@ -75,12 +71,7 @@ void add_ingest_command(CLI::App& app) {
     if (!args->matte.empty()) options.matte = args->matte;
     if (args->downsample) options.downsample = *args->downsample;
     if (args->threads) options.threads = *args->threads;
-    if (args->print_options) {
-      std::cout << "ingest:\n";
-      std::istringstream yaml(options_to_yaml(options));
-      for (std::string line; std::getline(yaml, line);) std::cout << "  " << line << "\n";
-      return;
-    }
+    if (args->options.print_if_asked(options)) return;
     if (args->capture.empty() || args->out.empty()) throw Error("tega ingest multiface needs --capture and --out");
     const auto s = ingest::ingest_multiface(args->capture, args->out, options, args->force);
     std::cout << s.dataset.string() << ": " << s.train_frames << " train + " << s.test_frames << " test frames, "

@@ -6,37 +6,34 @@
 #include "commands.h"
 #include "stage_options.h"
 #include "tega/core/error.h"
-#include "tega/tracking/landmark_capture_training.h"
+#include "tega/scoring/landmark_capture_training.h"
 
 namespace tega::cli {
 
 namespace {
 
 struct LandmarksTrainArguments {
-  std::vector<std::string> captures, overrides;
-  std::string out, model, config;
+  std::vector<std::string> captures;
+  std::string out, model;
   int threads = -1;
-  bool print_options = false;
+  StageOptionFlags options;
 };
 
 // Defaults, then the --config file's `landmarks` section, then --set, then the flags given.
-tracking::LandmarkPredictorOptions options_of(const LandmarksTrainArguments& a) {
-  auto options = load_stage_options<tracking::LandmarkPredictorOptions>(a.config, "landmarks", a.overrides);
+scoring::LandmarkPredictorOptions options_of(const LandmarksTrainArguments& a) {
+  auto options = a.options.load<scoring::LandmarkPredictorOptions>();
   if (!a.model.empty()) options.model = a.model;
   if (a.threads >= 0) options.training.threads = a.threads;
   return options;
 }
 
 void train(const LandmarksTrainArguments& args) {
-  const tracking::LandmarkPredictorOptions options = options_of(args);
-  if (args.print_options) {
-    print_stage_options("landmarks", options);
-    return;
-  }
+  const scoring::LandmarkPredictorOptions options = options_of(args);
+  if (args.options.print_if_asked(options)) return;
   if (args.captures.empty() || args.out.empty())
     throw Error("tega landmarks train: --capture (one or more) and --out are required");
   const std::vector<std::filesystem::path> captures(args.captures.begin(), args.captures.end());
-  const auto summary = tracking::train_landmark_predictor_on_captures(captures, options, args.out);
+  const auto summary = scoring::train_landmark_predictor_on_captures(captures, options, args.out);
   int trained = 0;
   for (const int count : summary.samples_per_capture) trained += count;
   std::printf("%s: trained on %d images of %zu capture(s) in %.0f s\n", args.out.c_str(), trained, captures.size(),
@@ -67,10 +64,7 @@ void add_landmarks_command(CLI::App& app) {
   cmd->add_option("--model", args->model,
                   "Head model directory with vertex_indices.json (default: the model each capture was rendered with).");
   cmd->add_option("--threads", args->threads, "Training threads (default: all).");
-  cmd->add_option("--config", args->config, "YAML file whose `landmarks` section sets options (see --print-options).");
-  cmd->add_option("--set", args->overrides,
-                  "Override one option, e.g. --set sampling.frame_stride=2 (repeatable).");
-  cmd->add_flag("--print-options", args->print_options, "Print every option with its default and exit.");
+  args->options.add_to(*cmd, "landmarks", "landmark training", "sampling.frame_stride=2");
   cmd->callback([args] { train(*args); });
 }
 

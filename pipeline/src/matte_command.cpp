@@ -12,10 +12,10 @@ namespace tega::cli {
 namespace {
 
 struct MatteArguments {
-  std::string capture, tracked, out, rig, config;
-  std::vector<std::string> takes, overrides;
+  std::string capture, tracked, out, rig;
+  std::vector<std::string> takes;
   int threads = -1;
-  bool print_options = false;
+  StageOptionFlags options;
 };
 
 }  // namespace
@@ -33,13 +33,11 @@ void add_matte_command(CLI::App& app) {
   cmd->add_option("--take", args->takes, "A take to matte (repeatable; default: every performance take).");
   cmd->add_option("--rig", args->rig, "Rig file (default: the capture's rig.json).");
   cmd->add_option("--threads", args->threads, "Worker threads (default: all).");
-  cmd->add_option("--config", args->config, "YAML file whose `matte` section sets options (see --print-options).");
-  cmd->add_option("--set", args->overrides, "Override one option, e.g. --set edge.band_px=4 (repeatable).");
-  cmd->add_flag("--print-options", args->print_options, "Print every matte option with its default and exit.");
+  args->options.add_to(*cmd, "matte", "matte", "edge.band_px=4");
   cmd->callback([args] {
-    auto options = load_stage_options<matting::MatteOptions>(args->config, "matte", args->overrides);
+    auto options = args->options.load<matting::MatteOptions>();
     if (args->threads >= 0) options.threads = args->threads;
-    if (args->print_options) return print_stage_options("matte", options);
+    if (args->options.print_if_asked(options)) return;
     if (args->capture.empty() || args->tracked.empty() || args->out.empty())
       throw Error("tega matte: --capture, --tracked and --out are required");
     const auto summary =

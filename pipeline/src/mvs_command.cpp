@@ -1,7 +1,5 @@
 // `tega mvs`: per-frame multi-view stereo meshes of a take (docs/mvs.md).
-#include <iostream>
 #include <memory>
-#include <sstream>
 
 #include "commands.h"
 #include "stage_options.h"
@@ -14,35 +12,27 @@ namespace tega::cli {
 namespace {
 
 struct MvsArguments {
-  std::string capture, out, rig, frames, config, device, images, workspace_dir, map_type = "geometric";
+  std::string capture, out, rig, frames, device, images, workspace_dir, map_type = "geometric";
   double rig_metres_per_unit = 1.0;
-  std::vector<std::string> takes, overrides;
+  std::vector<std::string> takes;
   int threads = -1;
-  bool workspace = false, print_options = false;
+  bool workspace = false;
+  StageOptionFlags options;
 };
 
 // Defaults, then the --config file's `mvs` section, then --set, then the flags given.
 mvs::Options options_of(const MvsArguments& a) {
-  mvs::Options options;
-  if (!a.config.empty()) load_options(options, a.config, "mvs");
-  apply_overrides(options, a.overrides);
+  auto options = a.options.load<mvs::Options>();
   if (!a.device.empty()) options.device = a.device;
   if (a.threads >= 0) options.threads = a.threads;
   if (a.workspace) options.write_workspace = true;
   return options;
 }
 
-void print_options(const mvs::Options& options) {
-  std::cout << "mvs:\n";
-  std::istringstream yaml(options_to_yaml(options));
-  for (std::string line; std::getline(yaml, line);) std::cout << "  " << line << "\n";
-}
-
 void add_shared_options(CLI::App& cmd, const std::shared_ptr<MvsArguments>& args) {
   cmd.add_option("--device", args->device, "cpu, cuda or auto (default auto: cuda when a GPU is available).");
   cmd.add_option("--threads", args->threads, "CPU worker threads (default: all).");
-  cmd.add_option("--config", args->config, "YAML file whose `mvs` section sets options (see --print-options).");
-  cmd.add_option("--set", args->overrides, "Override one option, e.g. --set patch_match.iterations=6 (repeatable).");
+  args->options.add_to(cmd, "mvs", "mvs", "patch_match.iterations=6");
 }
 
 void add_photos_command(CLI::App& mvs_command, const std::shared_ptr<MvsArguments>& args) {
@@ -55,8 +45,10 @@ void add_photos_command(CLI::App& mvs_command, const std::shared_ptr<MvsArgument
   cmd->add_option("--workspace", args->workspace_dir, "Also write a COLMAP dense workspace here.");
   add_shared_options(*cmd, args);
   cmd->callback([args] {
+    const mvs::Options options = options_of(*args);
+    if (args->options.print_if_asked(options)) return;
     mvs::PhotoRequest request{args->images, args->rig, args->rig_metres_per_unit, args->out, args->workspace_dir};
-    const auto t = mvs::reconstruct_photos(request, options_of(*args));
+    const auto t = mvs::reconstruct_photos(request, options);
     std::printf("%s: load %.1f s, depth %.1f s, fusion %.1f s, surface %.1f s\n", args->out.c_str(), t.load_s, t.depth_s,
                 t.fusion_s, t.surface_s);
   });
@@ -71,7 +63,9 @@ void add_mesh_workspace_command(CLI::App& mvs_command, const std::shared_ptr<Mvs
   cmd->add_option("--out", args->out, "The mesh to write (.ply).")->required();
   add_shared_options(*cmd, args);
   cmd->callback([args] {
-    const auto t = mvs::mesh_workspace(args->workspace_dir, args->out, options_of(*args), args->map_type);
+    const mvs::Options options = options_of(*args);
+    if (args->options.print_if_asked(options)) return;
+    const auto t = mvs::mesh_workspace(args->workspace_dir, args->out, options, args->map_type);
     std::printf("%s: load %.1f s, fusion %.1f s, surface %.1f s\n", args->out.c_str(), t.load_s, t.fusion_s, t.surface_s);
   });
 }
@@ -92,14 +86,13 @@ void add_mvs_command(CLI::App& app) {
   cmd->add_flag("--workspace", args->workspace,
                 "Also write each frame's COLMAP dense workspace (MESHES/<take>/colmap/<frame>/).");
   add_shared_options(*cmd, args);
-  cmd->add_flag("--print-options", args->print_options, "Print every mvs option with its default and exit.");
   cmd->require_subcommand(0, 1);
   add_photos_command(*cmd, args);
   add_mesh_workspace_command(*cmd, args);
   cmd->callback([cmd, args] {
     if (!cmd->get_subcommands().empty()) return;
     const mvs::Options options = options_of(*args);
-    if (args->print_options) return print_options(options);
+    if (args->options.print_if_asked(options)) return;
     if (args->capture.empty() || args->out.empty()) throw Error("tega mvs: --capture and --out are required");
     mvs::MvsRequest request;
     request.capture = args->capture;

@@ -17,18 +17,16 @@ namespace tega::cli {
 namespace {
 
 struct SynthArgs {
-  std::string out, config, head;
-  std::vector<std::string> overrides;
+  std::string out, head;
   int cameras = 0, frames = 0, width = 0, height = 0, threads = 0;
   int64_t seed = 0;
-  bool print_options = false, force = false, truth_apart = false;
+  bool force = false, truth_apart = false;
+  StageOptionFlags options;
   CLI::Option *cameras_opt, *frames_opt, *width_opt, *height_opt, *seed_opt, *head_opt, *threads_opt;
 };
 
 synth::Options resolve_options(const SynthArgs& a) {
-  synth::Options o;
-  if (!a.config.empty()) load_options(o, a.config);
-  apply_overrides(o, a.overrides);
+  auto o = a.options.load<synth::Options>();
   if (a.cameras_opt->count()) o.studio.cameras = a.cameras;
   if (a.width_opt->count()) o.studio.width = a.width;
   if (a.height_opt->count()) o.studio.height = a.height;
@@ -42,10 +40,7 @@ synth::Options resolve_options(const SynthArgs& a) {
 
 void run(const SynthArgs& a) {
   const synth::Options options = resolve_options(a);
-  if (a.print_options) {
-    std::cout << options_to_yaml(options);
-    return;
-  }
+  if (a.options.print_if_asked(options)) return;
   if (a.out.empty()) throw Error("tega synth: --out DIR is required");
   const synth::SynthSummary s = synth::render_virtual_studio(options, a.out, a.force);
   // With truth_apart the rig, ground truth and dataset lie beside the capture.
@@ -76,10 +71,7 @@ void add_synth_command(CLI::App& app) {
   args->head_opt = cmd->add_option("--head", args->head,
                                    "Blendshape model directory laid out like ICT-FaceKit (default: the built-in head).");
   args->threads_opt = cmd->add_option("--threads", args->threads, "Worker threads (default: one per hardware thread).");
-  cmd->add_option("--config", args->config, "YAML file of synth options (see --print-options); flags override it.");
-  cmd->add_option("--set", args->overrides,
-                  "Override one option over --config, e.g. --set tracking_error.lag=0 (repeatable).");
-  cmd->add_flag("--print-options", args->print_options, "Print the resolved options as documented YAML and exit.");
+  args->options.add_to(*cmd, "", "synth", "tracking_error.lag=0");
   cmd->add_flag("--force", args->force, "Replace an existing output directory.");
   cmd->add_flag("--truth-apart", args->truth_apart,
                 "A raw capture in --out (capture.json and takes/); its rig, ground truth and dataset in OUT.truth/.");

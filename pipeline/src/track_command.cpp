@@ -1,13 +1,11 @@
 // `tega track`: the head model fitted to every frame of a capture's takes (docs/tracking.md).
-#include <iostream>
 #include <memory>
-#include <sstream>
 
 #include "commands.h"
 #include "stage_options.h"
 #include "tega/core/error.h"
 #include "tega/core/options.h"
-#include "tega/tracking/evaluation.h"
+#include "tega/scoring/tracking_scores.h"
 #include "tega/tracking/tracking.h"
 
 namespace tega::cli {
@@ -15,18 +13,16 @@ namespace tega::cli {
 namespace {
 
 struct TrackArguments {
-  std::string capture, meshes, model, out, identity, rig, landmarks, config;
-  std::vector<std::string> takes, overrides;
+  std::string capture, meshes, model, out, identity, rig, landmarks;
+  std::vector<std::string> takes;
   int threads = -1;
-  bool print_options = false;
+  StageOptionFlags options;
   bool studio_truth = false;
 };
 
 // Defaults, then the --config file's `track` section, then --set, then the flags given.
 tracking::Options options_of(const TrackArguments& a) {
-  tracking::Options options;
-  if (!a.config.empty()) load_options(options, a.config, "track");
-  apply_overrides(options, a.overrides);
+  auto options = a.options.load<tracking::Options>();
   if (!a.model.empty()) options.model = a.model;
   if (!a.identity.empty()) options.identity = a.identity;
   if (!a.landmarks.empty()) options.landmarks.model = a.landmarks;
@@ -52,23 +48,16 @@ void add_track_command(CLI::App& app) {
   cmd->add_option("--rig", args->rig, "Rig file (default: the capture's rig.json).");
   cmd->add_option("--landmarks", args->landmarks, "A dlib 68-point shape predictor (.dat) for landmark terms.");
   cmd->add_option("--threads", args->threads, "Worker threads (default: all).");
-  cmd->add_option("--config", args->config, "YAML file whose `track` section sets options (see --print-options).");
-  cmd->add_option("--set", args->overrides, "Override one option, e.g. --set icp_iterations=6 (repeatable).");
-  cmd->add_flag("--print-options", args->print_options, "Print every track option with its default and exit.");
+  args->options.add_to(*cmd, "track", "track", "icp_iterations=6");
   cmd->add_flag("--studio-truth", args->studio_truth,
                 "Track nothing: write a virtual-studio capture's ground truth (its template, true meshes and poses) "
                 "in the tracked layout, to run the later stages apart from tracking's error.");
   cmd->callback([args] {
     const tracking::Options options = options_of(*args);
-    if (args->print_options) {
-      std::cout << "track:\n";
-      std::istringstream yaml(options_to_yaml(options));
-      for (std::string line; std::getline(yaml, line);) std::cout << "  " << line << "\n";
-      return;
-    }
+    if (args->options.print_if_asked(options)) return;
     if (args->studio_truth) {
       if (args->capture.empty() || args->out.empty()) throw Error("tega track --studio-truth: --capture and --out are required");
-      tracking::write_studio_truth_as_tracked(args->capture, args->out, args->takes);
+      scoring::write_studio_truth_as_tracked(args->capture, args->out, args->takes);
       std::printf("%s: the studio's ground truth in the tracked layout\n", args->out.c_str());
       return;
     }

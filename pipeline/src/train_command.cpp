@@ -12,13 +12,14 @@ namespace tega::cli {
 
 namespace {
 struct TrainArguments {
-  std::string data, out, config;
-  std::vector<std::string> overrides, ablations;
+  std::string data, out;
+  std::vector<std::string> ablations;
   std::string baseline;
   std::optional<int64_t> iterations;
   int64_t stop_at = 0;
   std::optional<std::string> device;
-  bool resume = false, force = false, profile = false, print_options = false;
+  bool resume = false, force = false, profile = false;
+  StageOptionFlags options;
 };
 }  // namespace
 
@@ -29,8 +30,7 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--out", args->out, "Run directory: checkpoint, metrics, options (docs/layouts.md#run).");
   cmd->add_option("--iterations", args->iterations, "Training iterations (default 60000; schedules scale with it).");
   cmd->add_option("--device", args->device, "cpu or cuda (default cpu).");
-  cmd->add_option("--config", args->config, "YAML file of training options (see --print-options).");
-  cmd->add_option("--set", args->overrides, "Override one option, e.g. --set densify.max_gaussians=1000000 (repeatable).");
+  args->options.add_to(*cmd, "", "training", "densify.max_gaussians=1000000");
   cmd->add_option("--ablation", args->ablations,
                   "Paper Table 1 ablation: no-warp, no-shading, no-network, no-densify, ga-binding, mlp-only, cap-200k "
                   "(repeatable).");
@@ -43,24 +43,20 @@ void add_train_command(CLI::App& app) {
                   "Stop with a checkpoint after this iteration; continue later with --resume.");
   cmd->add_flag("--force", args->force, "Start over even if --out already holds a run.");
   cmd->add_flag("--profile", args->profile, "Report the time of each part of a step (slower).");
-  cmd->add_flag("--print-options", args->print_options, "Print every training option with its default and exit.");
   cmd->callback([args] {
     trainer::TrainOptions options;
     if (args->resume) {
       load_options(options, std::filesystem::path(args->out) / "options.yaml");
-    } else if (!args->config.empty()) {
-      load_options(options, args->config);
+    } else if (!args->options.config.empty()) {
+      load_options(options, args->options.config);
     }
     if (!args->baseline.empty()) trainer::apply_baseline(options, args->baseline);
     for (const auto& ablation : args->ablations) trainer::apply_ablation(options, ablation);
-    apply_overrides(options, args->overrides);
+    apply_overrides(options, args->options.overrides);
     if (args->iterations) options.iterations = *args->iterations;
     if (args->device) options.device = *args->device;
     if (args->profile) options.profile = true;
-    if (args->print_options) {
-      std::cout << options_to_yaml(options);
-      return;
-    }
+    if (args->options.print_if_asked(options)) return;
     if (args->data.empty() || args->out.empty()) throw Error("tega train needs --data and --out");
     const auto s = trainer::train(args->data, args->out, options, {args->resume, args->force, args->stop_at});
     if (s.interrupted) {

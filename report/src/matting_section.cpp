@@ -12,9 +12,7 @@
 #include "tega/core/files.h"
 #include "tega/core/log.h"
 
-#ifdef TEGA_REPORT_HAVE_MATTING
-#include "tega/matting/matte_evaluation.h"
-#endif
+#include "tega/scoring/matte_scores.h"
 
 namespace tega::report {
 namespace fs = std::filesystem;
@@ -55,13 +53,12 @@ double coverage(const std::vector<fs::path>& mattes) {
   return pixels > 0 ? covered / pixels : 0;
 }
 
-#ifdef TEGA_REPORT_HAVE_MATTING
 // The matting issue's targets (docs/matting.md#figures): mean |alpha error|
 // 0.02 per image, 0.1 within 3 px of the edge, silhouette IoU 0.98.
 void score_take(const std::string& stage_name, const fs::path& mattes, const std::string& take, Section& section,
                 ReportContext& context) {
   logging::info("report: scoring the mattes of take %s against the studio's alpha", take.c_str());
-  const matting::MatteScores s = matting::score_mattes(mattes, context.subject.truth, take);
+  const scoring::MatteScores s = scoring::score_mattes(mattes, context.subject.truth, take);
   Table table{{"measure", "mean", "worst image", "target"}, {}};
   const std::string stage = stage_name + " (" + take + ")";
   table.rows.push_back({"|alpha error|", fixed(s.mean_error, 4), fixed(s.worst_mean_error, 4), "<= 0.02 per image"});
@@ -77,7 +74,6 @@ void score_take(const std::string& stage_name, const fs::path& mattes, const std
   section.text("Take " + take + " against the virtual studio's true alpha (" + std::to_string(s.images) + " images):");
   section.table(std::move(table));
 }
-#endif
 
 }  // namespace
 
@@ -115,7 +111,6 @@ Section matting_section(const StageOutput& stage, ReportContext& context) {
     for (const auto& line : take.not_matted) section.text("Not matted in " + take.name + ": frame " + line);
   context.add_figure(section, "matte_coverage.png", draw_bar_chart(chart), "Matte coverage per camera");
   if (context.scoring()) {
-#ifdef TEGA_REPORT_HAVE_MATTING
     for (const auto& [dir, take] : takes) {
       try {
         score_take(stage.stage, mattes, take.name, section, context);
@@ -123,9 +118,6 @@ Section matting_section(const StageOutput& stage, ReportContext& context) {
         context.score_errors.push_back(stage.stage + " (" + take.name + "): " + e.what());
       }
     }
-#else
-    context.score_errors.push_back(stage.stage + ": this build has no matting library to score mattes with");
-#endif
   }
   return section;
 }

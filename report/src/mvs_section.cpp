@@ -16,10 +16,8 @@
 #include "tega/core/rig.h"
 #include "tega/core/take.h"
 
-#ifdef TEGA_REPORT_HAVE_MVS
-#include "tega/mvs/evaluation.h"
-#include "tega/mvs/studio_truth.h"
-#endif
+#include "tega/scoring/studio_truth.h"
+#include "tega/scoring/surface_scores.h"
 
 namespace tega::report {
 namespace fs = std::filesystem;
@@ -69,7 +67,6 @@ double median(std::vector<double> values) {
   return values[values.size() / 2];
 }
 
-#ifdef TEGA_REPORT_HAVE_MVS
 
 // Targets of the MVS issue (docs/mvs.md#accuracy): at 512 x 384 a median
 // accuracy of 2 mm and 90 % of the face within 3 mm; at full size 0.3 mm and 95 % within 1 mm.
@@ -85,22 +82,20 @@ void score_meshes(const std::string& stage, const fs::path& meshes,
     count += spread(records.size(), size_t(context.options.scored_frames_per_take)).size();
   Progress progress("scoring MVS meshes against the studio's truth", int64_t(count), "meshes");
   const RigidTransform to_truth = calibrated_to_truth_world(context.subject);
-  mvs::EvaluationOptions options;
+  scoring::EvaluationOptions options;
   options.tolerances_m = {0.001, 0.002, 0.003};
   Table table{{"take", "frame", "accuracy median mm", "accuracy p90 mm", "within 1 / 2 / 3 mm %"}, {}};
   std::vector<double> accuracies, completeness;
-  const mvs::StudioTruthSource studio(context.subject.truth);
+  const scoring::StudioTruthSource studio(context.subject.truth);
   for (const auto& [take, records] : takes) {
     for (size_t i : spread(records.size(), size_t(context.options.scored_frames_per_take))) {
       const int frame = records[i].frame;
       char name[16];
       std::snprintf(name, sizeof name, "%06d.ply", frame);
-      const mvs::StudioTruth truth = studio.frame(take, frame);
+      const scoring::StudioTruth truth = studio.frame(take, frame);
       Mesh mesh = read_mesh(meshes / take / name);
-      for (int v = 0; v < mesh.positions.rows(); ++v)
-        mesh.positions.row(v) =
-            to_truth.apply(mesh.positions.row(v).cast<double>().transpose()).cast<float>().transpose();
-      const mvs::SurfaceScores s = mvs::evaluate_surface(mesh, truth.fine, truth.face_region, options);
+      mesh.positions = transformed(to_truth, mesh.positions);
+      const scoring::SurfaceScores s = scoring::evaluate_surface(mesh, truth.fine, truth.face_region, options);
       table.rows.push_back({take, std::to_string(frame), fixed(1000 * s.accuracy_median_m, 3),
                             fixed(1000 * s.accuracy_p90_m, 3),
                             fixed(100 * s.completeness[0], 1) + " / " + fixed(100 * s.completeness[1], 1) + " / " +
@@ -124,7 +119,6 @@ void score_meshes(const std::string& stage, const fs::path& meshes,
                             fixed(worst_completeness, 1) + " %", ">= " + fixed(completeness_target, 0) + " %",
                             verdict(worst_completeness >= completeness_target)});
 }
-#endif
 
 }  // namespace
 
@@ -156,15 +150,11 @@ Section mvs_section(const StageOutput& stage, ReportContext& context) {
     context.add_figure(section, "mvs_frames.png", draw_line_panels(panels, "frame"),
                        "Fused points and mesh size per frame");
   if (context.scoring()) {
-#ifdef TEGA_REPORT_HAVE_MVS
     try {
       score_meshes(stage.stage, meshes, takes, section, context);
     } catch (const std::exception& e) {
       context.score_errors.push_back(stage.stage + ": " + e.what());
     }
-#else
-    context.score_errors.push_back(stage.stage + ": this build has no mvs library to score meshes with");
-#endif
   }
   return section;
 }

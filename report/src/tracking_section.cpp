@@ -14,9 +14,7 @@
 #include "tega/core/files.h"
 #include "tega/core/log.h"
 
-#ifdef TEGA_REPORT_HAVE_TRACKING
-#include "tega/tracking/evaluation.h"
-#endif
+#include "tega/scoring/tracking_scores.h"
 
 namespace tega::report {
 namespace fs = std::filesystem;
@@ -78,13 +76,12 @@ double median_of(const std::vector<FrameResiduals>& frames, double FrameResidual
 
 std::string or_dash(double value, int decimals) { return std::isfinite(value) ? fixed(value, decimals) : "-"; }
 
-#ifdef TEGA_REPORT_HAVE_TRACKING
 // The tracking issue's targets (docs/tracking.md#accuracy): vertex error
 // median 1 mm and p95 3 mm, rotation 0.5 deg, blink and jaw correlation 0.9.
 void score_take(const std::string& stage, const fs::path& tracked, const std::string& take, Section& section,
                 ReportContext& context) {
   logging::info("report: scoring tracked take %s against the studio's truth", take.c_str());
-  const tracking::TrackScores s = tracking::score_against_studio(tracked, context.subject.truth, take,
+  const scoring::TrackScores s = scoring::score_against_studio(tracked, context.subject.truth, take,
                                                                     calibrated_to_truth_world(context.subject));
   Table table{{"measure", "value", "target"}, {}};
   const auto add = [&](const std::string& measure, double value, int decimals, const std::string& unit, double target,
@@ -107,7 +104,7 @@ void score_take(const std::string& stage, const fs::path& tracked, const std::st
     }
   }
   for (const auto& [expression, r] : s.correlation) {
-    if (tracking::has_correlation_target(expression)) {
+    if (scoring::has_correlation_target(expression)) {
       add("correlation " + expression, r, 3, "", 0.9, false);
     } else {
       table.rows.push_back({"correlation " + expression, fixed(r, 3), ""});
@@ -118,7 +115,6 @@ void score_take(const std::string& stage, const fs::path& tracked, const std::st
                " tracked frames, the face region's vertices):");
   section.table(std::move(table));
 }
-#endif
 
 }  // namespace
 
@@ -164,7 +160,6 @@ Section tracking_section(const StageOutput& stage, ReportContext& context) {
         }
   }
   if (context.scoring()) {
-#ifdef TEGA_REPORT_HAVE_TRACKING
     for (const auto& [take, frames] : takes) {
       try {
         score_take(stage.stage, tracked, take, section, context);
@@ -172,9 +167,6 @@ Section tracking_section(const StageOutput& stage, ReportContext& context) {
         context.score_errors.push_back(stage.stage + " (" + take + "): " + e.what());
       }
     }
-#else
-    context.score_errors.push_back(stage.stage + ": this build has no tracking library to score tracked meshes with");
-#endif
   }
   return section;
 }

@@ -45,9 +45,7 @@ void render_calibration(const Studio& studio, const std::string& take) {
   for (int f = 0; f < frames; ++f) {
     const RigidTransform& pose = poses[f];
     PosedBoard& p = posed[f];
-    p.positions.resize(front.num_vertices(), 3);
-    for (int v = 0; v < front.num_vertices(); ++v)
-      p.positions.row(v) = pose.apply(front.positions.row(v).cast<double>().transpose()).cast<float>().transpose();
+    p.positions = transformed(pose, front.positions);
     const Eigen::RowVector3f towards_front = (-pose.R.col(2)).cast<float>().transpose();
     p.front_normals = towards_front.replicate(front.num_vertices(), 1);
     p.back_normals = (-towards_front).replicate(front.num_vertices(), 1);

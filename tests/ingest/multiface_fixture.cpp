@@ -169,11 +169,7 @@ std::string six_digits(int n) {
 }  // namespace
 
 Vertices MultifaceFixture::world(const std::string& frame_id) const {
-  const RigidTransform& pose = poses.at(frame_id);
-  Vertices v = head_space.at(frame_id);
-  for (Eigen::Index i = 0; i < v.rows(); ++i)
-    v.row(i) = pose.apply(v.row(i).transpose().cast<double>()).cast<float>().transpose();
-  return v;
+  return transformed(poses.at(frame_id), head_space.at(frame_id));
 }
 
 Image8 MultifaceFixture::render(const Camera& camera, const std::string& frame_id) const {

@@ -16,8 +16,8 @@
 #include "tega/core/take.h"
 #include "tega/matting/dataset_build.h"
 #include "tega/matting/matte.h"
+#include "tega/scoring/tracking_scores.h"
 #include "tega/synth/virtual_studio.h"
-#include "tega/tracking/evaluation.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -50,7 +50,7 @@ class DatasetBuild : public ::testing::Test {
     studio.test_cameras = 2;
     studio.write_fine_meshes = false;
     synth::render_virtual_studio(studio, capture());
-    tracking::write_studio_truth_as_tracked(capture(), tracked());
+    scoring::write_studio_truth_as_tracked(capture(), tracked());
     write_true_mattes(capture(), mattes());
   }
   static void TearDownTestSuite() { delete dir_; }

@@ -14,9 +14,9 @@
 #include "tega/core/mesh.h"
 #include "tega/core/take.h"
 #include "tega/matting/matte.h"
-#include "tega/matting/matte_evaluation.h"
+#include "tega/scoring/matte_scores.h"
+#include "tega/scoring/tracking_scores.h"
 #include "tega/synth/virtual_studio.h"
-#include "tega/tracking/evaluation.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -26,7 +26,7 @@ namespace {
 
 constexpr int kFrames = 2;
 
-void print_scores(const char* label, const MatteScores& s) {
+void print_scores(const char* label, const scoring::MatteScores& s) {
   std::printf("%s: %d images, mean |error| %.4f (worst %.4f), within 3 px of the edge %.4f (worst %.4f), IoU %.4f "
               "(worst %.4f)\n",
               label, s.images, s.mean_error, s.worst_mean_error, s.boundary_error, s.worst_boundary_error, s.iou,
@@ -51,7 +51,7 @@ class Matte : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = new test::TempDir();
     synth::render_virtual_studio(test::small_studio(13, 512, 384, kFrames), capture());
-    tracking::write_studio_truth_as_tracked(capture(), tracked());
+    scoring::write_studio_truth_as_tracked(capture(), tracked());
     displace_tracked_meshes(tracked());
   }
   static void TearDownTestSuite() { delete dir_; }
@@ -74,7 +74,7 @@ TEST_F(Matte, MeetsTheTargetsWithAMeshMillimetresOff) {
   EXPECT_EQ(summary.images, 13 * kFrames);
   EXPECT_TRUE(summary.clean_plate);
   EXPECT_TRUE(fs::exists(out("mattes") / "expressions" / "mattes.json"));
-  const MatteScores s = score_mattes(out("mattes"), capture(), "expressions");
+  const scoring::MatteScores s = scoring::score_mattes(out("mattes"), capture(), "expressions");
   print_scores("clean plate and mesh", s);
   EXPECT_EQ(s.images, 13 * kFrames);
   EXPECT_LE(s.worst_mean_error, 0.02);
@@ -100,7 +100,7 @@ TEST_F(Matte, FollowsAnExposureDrift) {
     }
   }
   matte_capture({brighter, tracked(), out("mattes_brighter"), {}, {}}, options());
-  const MatteScores s = score_mattes(out("mattes_brighter"), brighter, "expressions");
+  const scoring::MatteScores s = scoring::score_mattes(out("mattes_brighter"), brighter, "expressions");
   print_scores("8 % brighter than the clean plate", s);
   EXPECT_LE(s.worst_mean_error, 0.02);
   EXPECT_LE(s.boundary_error, 0.1);
@@ -112,7 +112,7 @@ TEST_F(Matte, MattesWidePhotosAtAFractionOfTheirSize) {
   MatteOptions o = options();
   o.max_work_width = 256;
   matte_capture({capture(), tracked(), out("mattes_half"), {}, {}}, o);
-  const MatteScores s = score_mattes(out("mattes_half"), capture(), "expressions");
+  const scoring::MatteScores s = scoring::score_mattes(out("mattes_half"), capture(), "expressions");
   print_scores("matted at half size", s);
   EXPECT_LE(s.worst_mean_error, 0.02);
   EXPECT_LE(s.boundary_error, 0.15);
@@ -124,7 +124,7 @@ TEST_F(Matte, FallsBackOnTheMeshWithoutACleanPlate) {
   o.use_clean_plate = false;
   const MatteSummary summary = matte_capture({capture(), tracked(), out("mattes_mesh_only"), {}, {}}, o);
   EXPECT_FALSE(summary.clean_plate);
-  const MatteScores s = score_mattes(out("mattes_mesh_only"), capture(), "expressions");
+  const scoring::MatteScores s = scoring::score_mattes(out("mattes_mesh_only"), capture(), "expressions");
   print_scores("mesh alone", s);
   // The mesh is 2 mm off: the silhouette is right to a few pixels.
   EXPECT_LE(s.worst_mean_error, 0.05);

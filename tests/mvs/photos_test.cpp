@@ -5,9 +5,9 @@
 
 #include "tega/core/error.h"
 #include "tega/core/rig.h"
-#include "tega/mvs/evaluation.h"
 #include "tega/mvs/reconstruction.h"
-#include "tega/mvs/studio_truth.h"
+#include "tega/scoring/studio_truth.h"
+#include "tega/scoring/surface_scores.h"
 #include "tega/synth/virtual_studio.h"
 #include "small_studio.h"
 #include "test_support.h"
@@ -26,10 +26,10 @@ Options quick_options() {
   return o;
 }
 
-double completeness_at_3mm(const Mesh& mesh, const StudioTruth& truth, double& median_accuracy) {
-  EvaluationOptions eval;
+double completeness_at_3mm(const Mesh& mesh, const scoring::StudioTruth& truth, double& median_accuracy) {
+  scoring::EvaluationOptions eval;
   eval.tolerances_m = {0.003};
-  const SurfaceScores s = evaluate_surface(mesh, truth.fine, truth.face_region, eval);
+  const scoring::SurfaceScores s = scoring::evaluate_surface(mesh, truth.fine, truth.face_region, eval);
   median_accuracy = s.accuracy_median_m;
   return s.completeness[0];
 }
@@ -42,7 +42,7 @@ TEST(MvsPhotos, AColmapRiggedPhotoSetAndItsWorkspaceMeshTheFace) {
   fs::create_directories(dir / "photos");
   for (const auto& name : rig.camera_names())
     fs::copy_file(dir / "capture" / "takes" / "expressions" / name / "000000.png", dir / "photos" / (name + ".png"));
-  const StudioTruth truth = load_studio_truth(dir / "capture", "expressions", 0);
+  const scoring::StudioTruth truth = scoring::load_studio_truth(dir / "capture", "expressions", 0);
 
   const PhotoRequest request{dir / "photos", dir / "sparse", 1.0, dir / "photos.ply", dir / "workspace"};
   reconstruct_photos(request, quick_options());

@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "tega/core/image.h"
+#include "tega/core/take_images.h"
 #include "tega/core/thread_pool.h"
 #include "tega/mvs/frame_views.h"
 #include "tega/mvs/fusion.h"

@@ -8,9 +8,9 @@
 #include "tega/core/error.h"
 #include "tega/core/files.h"
 #include "tega/core/rig.h"
-#include "tega/mvs/evaluation.h"
 #include "tega/mvs/reconstruction.h"
-#include "tega/mvs/studio_truth.h"
+#include "tega/scoring/studio_truth.h"
+#include "tega/scoring/surface_scores.h"
 #include "tega/synth/virtual_studio.h"
 #include "small_studio.h"
 #include "test_support.h"
@@ -55,10 +55,10 @@ TEST(Mvs, MeshesTheFaceWithinTheTargets) {
   const MvsSummary summary = reconstruct_capture(request, cpu_options());
   EXPECT_EQ(summary.frames_done, 1);
   const Mesh mesh = read_mesh(out / "meshes" / "expressions" / "000000.ply");
-  const StudioTruth truth = load_studio_truth(studio_capture(), "expressions", 0);
-  EvaluationOptions eval;
+  const scoring::StudioTruth truth = scoring::load_studio_truth(studio_capture(), "expressions", 0);
+  scoring::EvaluationOptions eval;
   eval.tolerances_m = {0.003};
-  const SurfaceScores scores = evaluate_surface(mesh, truth.fine, truth.face_region, eval);
+  const scoring::SurfaceScores scores = scoring::evaluate_surface(mesh, truth.fine, truth.face_region, eval);
   std::printf("512x384, 13 cameras: accuracy median %.2f mm (p90 %.2f mm), completeness at 3 mm %.1f %%\n",
               1000 * scores.accuracy_median_m, 1000 * scores.accuracy_p90_m, 100 * scores.completeness[0]);
   EXPECT_LE(scores.accuracy_median_m, 0.002);

@@ -15,11 +15,8 @@
 #include "tega/core/mesh.h"
 #include "tega/core/rig.h"
 #include "tega/pipeline/manifest.h"
+#include "tega/scoring/tracking_scores.h"
 #include "test_support.h"
-
-#ifdef TEGA_TEST_HAVE_TRACKING
-#include "tega/tracking/evaluation.h"
-#endif
 
 namespace tega::test {
 namespace {
@@ -186,7 +183,6 @@ TEST_F(ReportStudio, AnUnknownSubjectOrANonWorkspaceIsAnError) {
   EXPECT_TRUE(has(not_workspace.output, "is not a tega workspace")) << not_workspace.output;
 }
 
-#ifdef TEGA_TEST_HAVE_TRACKING
 // A committed shard made outside `tega run`: its manifest matches nothing, so
 // `tega status` calls it stale, but its outputs are there to report on.
 void commit_by_hand(const fs::path& shard, const std::string& stage, const std::string& kind) {
@@ -202,7 +198,7 @@ TEST_F(ReportStudio, AFittedSubjectsTurnIsNotATurnOfTheHead) {
   const fs::path capture = workspace() / "synth/alice/capture";
   TempDir dir;
   const fs::path tracked = dir / "tracked";
-  tracking::write_studio_truth_as_tracked(capture, tracked);
+  scoring::write_studio_truth_as_tracked(capture, tracked);
   const Eigen::Matrix3d turn = Eigen::AngleAxisd(M_PI / 180, Eigen::Vector3d(1, 0.3, 0).normalized()).matrix();
   Mesh neutral = read_obj(tracked / "identity_neutral.obj");
   neutral.positions = (neutral.positions.cast<double>() * turn.transpose()).cast<float>();
@@ -218,7 +214,7 @@ TEST_F(ReportStudio, AFittedSubjectsTurnIsNotATurnOfTheHead) {
       for (int c = 0; c < 3; ++c) record["head_to_world"][r][c] = turned_back(r, c);
     write_text(entry.path(), record.dump());
   }
-  const tracking::TrackScores s = tracking::score_against_studio(tracked, capture, "expressions");
+  const scoring::TrackScores s = scoring::score_against_studio(tracked, capture, "expressions");
   EXPECT_LT(s.rotation_max_deg, 1e-3);
   EXPECT_NEAR(s.subject_rotation_deg, 1.0, 1e-3);
   EXPECT_NEAR(s.pose_rotation_median_deg, 1.0, 1e-3);
@@ -234,7 +230,7 @@ TEST_F(ReportStudio, ZTrackedAndMattedShardsAreShownAndScoredAgainstTheTruth) {
   // Where tracking with the calibrated rig would put them: in its world.
   const Rig calibrated = read_rig_json(workspace() / "calibrate/alice/rig.json");
   const Rig truth = read_rig_json(capture / "rig.json");
-  tracking::write_studio_truth_as_tracked(capture, workspace() / "track/alice/tracked", {},
+  scoring::write_studio_truth_as_tracked(capture, workspace() / "track/alice/tracked", {},
                                           align_camera_centres(truth, calibrated));
   commit_by_hand(workspace() / "track/alice", "track", "track");
   const fs::path take = workspace() / "matte/alice/mattes/expressions";
@@ -271,7 +267,6 @@ TEST_F(ReportStudio, ZTrackedAndMattedShardsAreShownAndScoredAgainstTheTruth) {
       << self_test;
   EXPECT_FALSE(has(self_test, "Not scored")) << self_test;
 }
-#endif
 
 // Trained, evaluated and rendered on the tiniest capture.
 class ReportTraining : public Workspace {

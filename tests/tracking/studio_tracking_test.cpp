@@ -15,10 +15,11 @@
 #include "tega/core/files.h"
 #include "tega/core/mesh.h"
 #include "tega/core/rig.h"
+#include "tega/landmarks/landmarks.h"
 #include "tega/mvs/reconstruction.h"
+#include "tega/scoring/studio_landmarks.h"
+#include "tega/scoring/tracking_scores.h"
 #include "tega/synth/virtual_studio.h"
-#include "tega/tracking/evaluation.h"
-#include "tega/tracking/landmarks.h"
 #include "tega/tracking/tracking.h"
 #include "test_support.h"
 
@@ -29,7 +30,7 @@ namespace {
 
 constexpr int kFrames = 8;
 
-void print_scores(const char* label, const TrackScores& s) {
+void print_scores(const char* label, const scoring::TrackScores& s) {
   std::printf("%s: %d frames, vertex error median %.3f mm, p95 %.3f mm, rotation median %.3f deg, max %.3f deg\n",
               label, s.frames, 1000 * s.vertex_median_m, 1000 * s.vertex_p95_m, s.rotation_median_deg,
               s.rotation_max_deg);
@@ -42,7 +43,7 @@ struct Bounds {
   double median_m, p95_m, rotation_deg, jaw_r, blink_r;
 };
 
-void expect_within(const TrackScores& s, const Bounds& b) {
+void expect_within(const scoring::TrackScores& s, const Bounds& b) {
   EXPECT_EQ(s.frames, kFrames);
   EXPECT_LE(s.vertex_median_m, b.median_m);
   EXPECT_LE(s.vertex_p95_m, b.p95_m);
@@ -100,8 +101,7 @@ void move_tracked_take(const fs::path& from, const fs::path& to, const RigidTran
     test::write_text(file.path(), record.dump());
     const fs::path mesh = to / record["mesh"].get<std::string>();
     Vertices vertices = read_vertices_bin(mesh);
-    for (Eigen::Index v = 0; v < vertices.rows(); ++v)
-      vertices.row(v) = world_change.apply(vertices.row(v).transpose().cast<double>()).cast<float>().transpose();
+    vertices = transformed(world_change, vertices);
     write_vertices_bin(vertices, mesh);
   }
 }
@@ -122,8 +122,8 @@ void write_true_scans(const fs::path& capture, const fs::path& meshes) {
 }
 
 TEST(StudioTracking, OnlyTheEyelidsAndTheJawHaveACorrelationTarget) {
-  for (const char* name : {"eyeBlink_L", "eyeBlink_R", "jawOpen", "jawLeft"}) EXPECT_TRUE(has_correlation_target(name));
-  for (const char* name : {"browInnerUp_L", "mouthSmile_R", "eyeWide_L", ""}) EXPECT_FALSE(has_correlation_target(name));
+  for (const char* name : {"eyeBlink_L", "eyeBlink_R", "jawOpen", "jawLeft"}) EXPECT_TRUE(scoring::has_correlation_target(name));
+  for (const char* name : {"browInnerUp_L", "mouthSmile_R", "eyeWide_L", ""}) EXPECT_FALSE(scoring::has_correlation_target(name));
 }
 
 TEST(StudioTracking, TracksTegasOwnMeshesWithinTheTargets) {
@@ -158,8 +158,8 @@ TEST(StudioTracking, TracksTegasOwnMeshesWithinTheTargets) {
   const TrackSummary summary = track_capture({capture, {}, dir / "meshes", dir / "tracked", {}}, options);
   EXPECT_EQ(summary.frames_tracked, kFrames);
   // One truth for every scoring below: its face regions cost a depth render per camera and frame.
-  const TakeTruth truth(capture, "expressions");
-  const TrackScores scores = score_against_studio(dir / "tracked", truth);
+  const scoring::TakeTruth truth(capture, "expressions");
+  const scoring::TrackScores scores = scoring::score_against_studio(dir / "tracked", truth);
   print_scores("tega's MVS meshes", scores);
   expect_within(scores, {0.002, 0.007, 1.0, 0.95, 0.85});
   expect_eyelids_seen(dir / "tracked" / "expressions", capture);
@@ -187,24 +187,24 @@ TEST(StudioTracking, TracksTegasOwnMeshesWithinTheTargets) {
   // new to it; landmark_test.cpp scores predictors on unseen frames).
   const auto indices = nlohmann::json::parse(read_text_file(*shared / "ict-facekit" / "vertex_indices.json"));
   const auto landmark_vertices = indices.at("idx_to_landmark_verts").get<std::vector<int>>();
-  std::vector<LandmarkSample> samples;
+  std::vector<landmarks::LandmarkSample> samples;
   for (const auto& camera : read_rig_json(capture / "rig.json").camera_names())
     for (int frame = 0; frame < kFrames; frame += 2) {
-      LandmarkSample sample = studio_landmark_sample(capture, "expressions", camera, frame, landmark_vertices);
+      landmarks::LandmarkSample sample = scoring::studio_landmark_sample(capture, "expressions", camera, frame, landmark_vertices);
       const auto known = std::count_if(sample.landmarks.begin(), sample.landmarks.end(),
                                        [](const Eigen::Vector2d& l) { return l.allFinite(); });
-      if (known >= kLandmarkCount - 8) samples.push_back(std::move(sample));  // the jaw line's far end may hide
+      if (known >= landmarks::kLandmarkCount - 8) samples.push_back(std::move(sample));  // the jaw line's far end may hide
     }
-  LandmarkTrainingOptions training;
+  landmarks::LandmarkTrainingOptions training;
   training.threads = 2;
   ASSERT_GE(samples.size(), 8u);
-  train_landmark_predictor(samples, training, dir / "predictor.dat");
+  landmarks::train_landmark_predictor(samples, training, dir / "predictor.dat");
   Options with_landmarks = options;
   with_landmarks.identity = (dir / "tracked" / "identity.json").string();
   with_landmarks.landmarks.model = (dir / "predictor.dat").string();
   track_capture({capture, {}, dir / "meshes", dir / "tracked_with_landmarks", {}}, with_landmarks);
-  const TrackScores landmarked =
-      score_against_studio(dir / "tracked_with_landmarks", truth);
+  const scoring::TrackScores landmarked =
+      scoring::score_against_studio(dir / "tracked_with_landmarks", truth);
   print_scores("tega's MVS meshes, with landmarks", landmarked);
   expect_within(landmarked, Bounds{0.002, 0.007, 1.0, 0.95, 0.85});
   const auto with_points =
@@ -218,7 +218,7 @@ TEST(StudioTracking, TracksTegasOwnMeshesWithinTheTargets) {
   reuse.identity = (dir / "tracked" / "identity.json").string();
   reuse.flow.enabled = true;
   track_capture({capture, {}, dir / "true_meshes", dir / "tracked_on_truth", {}}, reuse);
-  const TrackScores bound = score_against_studio(dir / "tracked_on_truth", truth);
+  const scoring::TrackScores bound = scoring::score_against_studio(dir / "tracked_on_truth", truth);
   print_scores("true meshes, with flow", bound);
   expect_within(bound, {0.002, 0.005, 1.0, 0.95, 0.85});
 
@@ -228,11 +228,11 @@ TEST(StudioTracking, TracksTegasOwnMeshesWithinTheTargets) {
                                         Eigen::Vector3d(0.1, -0.05, 1.0)};
   move_tracked_take(dir / "tracked_on_truth" / "expressions", dir / "tracked_elsewhere" / "expressions",
                     calibrated_world);
-  const TrackScores elsewhere =
-      score_against_studio(dir / "tracked_elsewhere", truth, calibrated_world.inverse());
+  const scoring::TrackScores elsewhere =
+      scoring::score_against_studio(dir / "tracked_elsewhere", truth, calibrated_world.inverse());
   EXPECT_NEAR(elsewhere.vertex_median_m, bound.vertex_median_m, 1e-6);
   EXPECT_NEAR(elsewhere.rotation_median_deg, bound.rotation_median_deg, 1e-3);
-  EXPECT_GT(score_against_studio(dir / "tracked_elsewhere", truth).rotation_median_deg, 20);
+  EXPECT_GT(scoring::score_against_studio(dir / "tracked_elsewhere", truth).rotation_median_deg, 20);
   const auto flowed = nlohmann::json::parse(read_text_file(dir / "tracked_on_truth" / "expressions" / "000004.json"));
   EXPECT_GT(flowed["residuals"]["flow_points"].get<int>(), 1000);
   EXPECT_LT(flowed["residuals"]["flow_rms_px"].get<double>(), 5.0);

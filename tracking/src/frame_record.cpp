@@ -1,23 +1,15 @@
 #include "frame_record.h"
 
-#include <cstdio>
 #include <nlohmann/json.hpp>
 
 #include "tega/core/error.h"
-#include "tega/core/files.h"
 #include "tega/core/mesh.h"
-#include "tega/tracking/tracked.h"
+#include "tega/core/tracked.h"
 
 namespace tega::tracking {
 namespace fs = std::filesystem;
 
 namespace {
-
-fs::path frame_file(const fs::path& dir, int frame, const char* extension) {
-  char name[32];
-  std::snprintf(name, sizeof name, "%06d%s", frame, extension);
-  return dir / name;
-}
 
 nlohmann::json residuals_json(const FrameResiduals& r) {
   nlohmann::json j = {{"surface_median_mm", 1000 * r.surface_median_m},
@@ -48,31 +40,21 @@ FrameResiduals residuals_of(const nlohmann::json& j) {
 
 void write_frame_record(const fs::path& take_dir, const FrameRecord& record, const Vertices* vertices,
                         const HeadModel& model) {
-  nlohmann::json j;
-  j["frame"] = record.frame;
-  j["status"] = record.status;
-  if (!record.reason.empty()) j["reason"] = record.reason;
-  if (record.fitted_afresh) j["fitted_afresh"] = true;
-  if (record.status != "skipped") {
-    const auto m = record.state.head_to_world.matrix();
-    j["head_to_world"] = nlohmann::json::array();
-    for (int r = 0; r < 3; ++r) j["head_to_world"].push_back({m(r, 0), m(r, 1), m(r, 2), m(r, 3)});
-    nlohmann::json expression = nlohmann::json::object();
-    for (size_t k = 0; k < record.state.expression.size(); ++k)
-      expression[model.shapes.expression_names[k]] = record.state.expression[k];
-    j["expression"] = expression;
-    j["residuals"] = residuals_json(record.residuals);
-  }
-  if (vertices) {
-    write_vertices_bin(*vertices, frame_file(take_dir, record.frame, ".bin"));
-    j["mesh"] = frame_file(take_dir, record.frame, ".bin").filename().string();
-  }
-  write_text_atomic(frame_file(take_dir, record.frame, ".json"), j.dump(2) + "\n");
+  TrackedFrame frame;
+  frame.frame = record.frame;
+  frame.status = record.status;
+  frame.reason = record.reason;
+  frame.fitted_afresh = record.fitted_afresh;
+  frame.head_to_world = record.state.head_to_world;
+  for (size_t k = 0; k < record.state.expression.size(); ++k)
+    frame.expression[model.shapes.expression_names[k]] = record.state.expression[k];
+  frame.residuals = residuals_json(record.residuals);
+  write_tracked_frame(take_dir, frame, vertices);
 }
 
 std::optional<StoredFrame> read_frame_record(const fs::path& take_dir, int frame, const HeadModel& model,
                                              const SubjectIdentity* subject) {
-  const fs::path file = frame_file(take_dir, frame, ".json");
+  const fs::path file = tracked_frame_file(take_dir, frame, ".json");
   if (!fs::exists(file)) return std::nullopt;
   StoredFrame stored;
   FrameRecord& record = stored.record;
@@ -88,16 +70,15 @@ std::optional<StoredFrame> read_frame_record(const fs::path& take_dir, int frame
       record.state.expression.push_back(tracked.expression.at(name));
     }
     try {
-      const nlohmann::json j = nlohmann::json::parse(read_text_file(file));
-      record.residuals = residuals_of(j.at("residuals"));
-      record.fitted_afresh = j.value("fitted_afresh", false);
+      record.residuals = residuals_of(tracked.residuals);
     } catch (const nlohmann::json::exception& e) {
       throw Error(file, std::string("is not a valid frame record: ") + e.what());
     }
+    record.fitted_afresh = tracked.fitted_afresh;
   }
   stored.state = record.state;
   if (record.status == "tracked" && subject) {
-    const Vertices world = read_vertices_bin(frame_file(take_dir, frame, ".bin"), model.num_vertices());
+    const Vertices world = read_vertices_bin(tracked_frame_file(take_dir, frame, ".bin"), model.num_vertices());
     HeadState shaped = record.state;
     shaped.corrections.resize(0, 3);
     const Vertices without = pose_vertices(model, *subject, shaped);

@@ -91,7 +91,7 @@ std::vector<bool> visible_from(const Eigen::Vector3d& eye, const PosedModel& pos
 
 Term<ImageTarget> landmark_targets(const HeadModel& model, const PosedModel& posed, const FrameObservation& frame,
                                    const std::vector<Camera>& cameras, const SurfaceQuery& scan,
-                                   const LandmarkDetector& detector, const LandmarkOptions& options) {
+                                   const landmarks::LandmarkDetector& detector, const LandmarkOptions& options) {
   Term<ImageTarget> term;
   term.scale = scale_of(options.term);
   if (model.landmark_vertices.empty()) return term;
@@ -101,15 +101,15 @@ Term<ImageTarget> landmark_targets(const HeadModel& model, const PosedModel& pos
     const Image8& image = frame.images.at(size_t(c));
     if (image.pixels.empty()) return;
     const Camera& camera = cameras[size_t(c)];
-    FaceBox box;
+    landmarks::FaceBox box;
     for (int v : model.landmark_vertices) {
       const auto pixel = camera.project(posed.world.row(v).cast<double>().transpose());
       if (!pixel) return;
       box.extend(*pixel);
     }
     box = grown_landmark_box(box);
-    if (!box.intersects(FaceBox(Eigen::Vector2d::Zero(), Eigen::Vector2d(image.width, image.height)))) return;
-    const auto found = detector.detect(image, options.detector_boxes ? std::nullopt : std::optional<FaceBox>(box));
+    if (!box.intersects(landmarks::FaceBox(Eigen::Vector2d::Zero(), Eigen::Vector2d(image.width, image.height)))) return;
+    const auto found = detector.detect(image, options.detector_boxes ? std::nullopt : std::optional<landmarks::FaceBox>(box));
     if (!found) return;
     const std::vector<int> inner(model.landmark_vertices.begin() + kFirstInnerLandmark, model.landmark_vertices.end());
     const std::vector<bool> visible = visible_from(camera.center(), posed, inner, scan);

@@ -7,7 +7,7 @@
 #include "model_fit.h"
 #include "optical_flow.h"
 #include "surface_query.h"
-#include "tega/tracking/landmarks.h"
+#include "tega/landmarks/landmarks.h"
 #include "tega/tracking/options.h"
 #include "tega/tracking/tracker.h"
 
@@ -37,7 +37,7 @@ std::vector<bool> visible_from(const Eigen::Vector3d& eye, const PosedModel& pos
 // box around where the posed model's landmarks project.
 Term<ImageTarget> landmark_targets(const HeadModel& model, const PosedModel& posed, const FrameObservation& frame,
                                    const std::vector<Camera>& cameras, const SurfaceQuery& scan,
-                                   const LandmarkDetector& detector, const LandmarkOptions& options);
+                                   const landmarks::LandmarkDetector& detector, const LandmarkOptions& options);
 
 // Where every vertex_step-th fit vertex, visible in a camera at the previous
 // frame, went by that camera's flow.

@@ -35,18 +35,18 @@ Eigen::Vector3d closest_to_rays(const std::vector<std::pair<Eigen::Vector3d, Eig
 
 std::optional<RigidTransform> pose_from_landmarks(const HeadModel& model, const Vertices& neutral,
                                                   const FrameObservation& frame, const std::vector<Camera>& cameras,
-                                                  const LandmarkDetector& detector, int min_views) {
+                                                  const landmarks::LandmarkDetector& detector, int min_views) {
   if (model.landmark_vertices.empty()) return std::nullopt;
-  std::vector<std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>> rays(kLandmarkCount);
+  std::vector<std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>> rays(landmarks::kLandmarkCount);
   for (size_t c = 0; c < cameras.size(); ++c) {
     if (c >= frame.images.size() || frame.images[c].pixels.empty()) continue;
     const auto found = detector.detect(frame.images[c], std::nullopt);
     if (!found) continue;
-    for (int l = 0; l < kLandmarkCount; ++l)
+    for (int l = 0; l < landmarks::kLandmarkCount; ++l)
       rays[size_t(l)].emplace_back(cameras[c].center(), cameras[c].ray_direction((*found)[size_t(l)]));
   }
   std::vector<Eigen::Vector3d> head_points, world_points;
-  for (int l = 17; l < kLandmarkCount; ++l) {  // the jaw line is a silhouette, not a point
+  for (int l = 17; l < landmarks::kLandmarkCount; ++l) {  // the jaw line is a silhouette, not a point
     if (int(rays[size_t(l)].size()) < std::max(2, min_views)) continue;
     head_points.push_back(neutral.row(model.landmark_vertices[size_t(l)]).cast<double>().transpose());
     world_points.push_back(closest_to_rays(rays[size_t(l)]));
@@ -103,9 +103,7 @@ RigidFit rigid_icp(const HeadModel& model, const Vertices& neutral, const Surfac
   std::vector<double> none;
   size_t supported = 0;
   for (int it = 0; it < kRigidIcpIterations; ++it) {
-    Vertices world = neutral;
-    for (int v = 0; v < world.rows(); ++v)
-      world.row(v) = poses[0].apply(neutral.row(v).cast<double>().transpose()).cast<float>().transpose();
+    const Vertices world = transformed(poses[0], neutral);
     const double bound = kRigidIcpStartDistanceM + (options.surface.max_distance_m - kRigidIcpStartDistanceM) *
                                                        double(it) / (kRigidIcpIterations - 1);
     CoefficientProblem problem;
@@ -133,7 +131,7 @@ Error no_head_near() {
 
 RigidTransform initial_pose(const HeadModel& model, const Vertices& neutral, const FrameObservation& frame,
                             const std::vector<Camera>& cameras, const Options& options,
-                            const LandmarkDetector* landmarks) {
+                            const landmarks::LandmarkDetector* landmarks) {
   const SurfaceQuery scan(*frame.scan);
   if (landmarks) {
     if (auto pose = pose_from_landmarks(model, neutral, frame, cameras, *landmarks, options.landmarks.min_views)) {

@@ -2,9 +2,7 @@
 
 #include <algorithm>
 
-#include "tega/core/downsample.h"
-#include "tega/mvs/debayer.h"
-#include "tega/mvs/frame_views.h"
+#include "tega/core/take_images.h"
 
 namespace tega::tracking {
 
@@ -28,15 +26,10 @@ std::vector<Camera> photo_cameras(const std::vector<Camera>& cameras, int factor
 
 std::vector<Image8> frame_photos(const TakeInfo& take, int frame, int factor, ThreadPool& pool) {
   std::vector<Image8> photos(take.cameras.size());
-  const bool bayer = take.pixel_format.rfind("Bayer", 0) == 0;
   pool.parallel_for(0, int64_t(take.cameras.size()), [&](int64_t c) {
     const std::string& camera = take.cameras[size_t(c)];
     if (!take.has_image(camera, frame)) return;
-    const Image8 raw = read_image_u8(take.image_path(camera, frame));
-    if (bayer && factor % 2 == 0)
-      photos[size_t(c)] = box_downsample_dropping_remainder(mvs::debayer_half(raw, take.pixel_format), factor / 2);
-    else
-      photos[size_t(c)] = box_downsample_dropping_remainder(bayer ? mvs::debayer(raw, take.pixel_format) : mvs::rgb_of(raw), factor);
+    photos[size_t(c)] = read_recorded_rgb(take, camera, frame, factor);
   });
   return photos;
 }

@@ -6,9 +6,8 @@
 
 #include "tega/core/image.h"
 #include "tega/core/mesh.h"
+#include "tega/core/take_images.h"
 #include "tega/core/thread_pool.h"
-#include "tega/mvs/debayer.h"
-#include "tega/mvs/frame_views.h"
 
 namespace tega::tracking {
 namespace fs = std::filesystem;
@@ -99,8 +98,7 @@ size_t frontal_camera(const std::vector<Camera>& cameras, const RigidTransform& 
 void draw_overlay(const TakeInfo& take, const Camera& camera, size_t camera_index, const FrameRecord& record,
                   const HeadModel& model, const fs::path& take_dir, const fs::path& file) {
   if (!take.has_image(take.cameras[camera_index], record.frame)) return;
-  const Image8 raw = read_image_u8(take.image_path(take.cameras[camera_index], record.frame));
-  Image8 photo = take.pixel_format.rfind("Bayer", 0) == 0 ? mvs::debayer(raw, take.pixel_format) : mvs::rgb_of(raw);
+  Image8 photo = read_recorded_rgb(take, take.cameras[camera_index], record.frame);
   char name[32];
   std::snprintf(name, sizeof name, "%06d.bin", record.frame);
   const Vertices world = read_vertices_bin(take_dir / name, model.num_vertices());

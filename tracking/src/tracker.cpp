@@ -81,7 +81,7 @@ Vertices pose_vertices(const HeadModel& model, const SubjectIdentity& subject, c
 
 SubjectIdentity fit_identity(const HeadModel& model, const std::vector<FrameObservation>& frames,
                              const std::vector<Camera>& cameras, const Options& options,
-                             const LandmarkDetector* landmarks) {
+                             const landmarks::LandmarkDetector* landmarks) {
   if (frames.empty()) throw Error("fitting the identity needs at least one frame");
   const Vertices& mean = model.shapes.neutral.positions;
   std::vector<std::unique_ptr<SurfaceQuery>> scans;
@@ -155,7 +155,7 @@ struct TakeTracker::Previous {
 };
 
 TakeTracker::TakeTracker(const HeadModel& model, const SubjectIdentity& subject, std::vector<Camera> cameras,
-                         const Options& options, const LandmarkDetector* landmarks)
+                         const Options& options, const landmarks::LandmarkDetector* landmarks)
     : model_(model),
       subject_(subject),
       cameras_(std::move(cameras)),

@@ -13,7 +13,7 @@
 #include "tega/core/rig.h"
 #include "tega/core/take.h"
 #include "tega/core/thread_pool.h"
-#include "tega/tracking/landmarks.h"
+#include "tega/landmarks/landmarks.h"
 #include "tega/tracking/photos.h"
 
 namespace tega::tracking {
@@ -46,13 +46,13 @@ struct TakeContext {
   const std::vector<Camera>& photo_cameras;  // ... and their cameras
   const HeadModel& model;
   const SubjectIdentity& subject;
-  const LandmarkDetector* landmarks;
+  const landmarks::LandmarkDetector* landmarks;
   fs::path meshes;  // MESHES/<take>
   fs::path out;     // TRACKED/<take>
   std::string made_with;
 };
 
-bool needs_photos(const Options& o, const LandmarkDetector* landmarks) {
+bool needs_photos(const Options& o, const landmarks::LandmarkDetector* landmarks) {
   return o.flow.enabled || o.eyelids.enabled || landmarks;
 }
 
@@ -146,7 +146,7 @@ void track_take(const TakeContext& t, const Options& options, TrackSummary& summ
 
 // The first frames of the first take, each with its scan and photos.
 SubjectIdentity identity_of(const TrackRequest& request, const TakeInfo& first, const std::vector<Camera>& cameras,
-                            const HeadModel& model, const Options& options, const LandmarkDetector* landmarks,
+                            const HeadModel& model, const Options& options, const landmarks::LandmarkDetector* landmarks,
                             ThreadPool& pool) {
   const int photo_factor = photo_downsample(cameras, options.photo_max_side);
   std::vector<Mesh> scans;
@@ -182,8 +182,8 @@ TrackSummary track_capture(const TrackRequest& request, const Options& options) 
     if (point < 0 || point >= 68)
       throw Error("track: landmarks.ignored_points holds " + std::to_string(point) + "; points are numbered 0 to 67");
   const HeadModel model = load_head_model(options.model, options.model_metres_per_unit);
-  std::unique_ptr<LandmarkDetector> landmarks;
-  if (!options.landmarks.model.empty()) landmarks = std::make_unique<LandmarkDetector>(options.landmarks.model);
+  std::unique_ptr<landmarks::LandmarkDetector> landmarks;
+  if (!options.landmarks.model.empty()) landmarks = std::make_unique<tega::landmarks::LandmarkDetector>(options.landmarks.model);
   ThreadPool pool(options.threads);
   fs::create_directories(request.out);
 

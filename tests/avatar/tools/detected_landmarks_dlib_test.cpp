@@ -12,7 +12,7 @@
 
 #include "tega/core/error.h"
 #include "tega/tools/detected_landmarks.h"
-#include "tega/tracking/landmarks.h"
+#include "tega/landmarks/landmarks.h"
 #include "test_support.h"
 
 namespace {
@@ -58,7 +58,7 @@ const std::vector<Eigen::Vector2d>& pattern_landmarks() {
     std::mt19937 random(5);
     std::uniform_real_distribution<double> offset(-20, 20);
     std::vector<Eigen::Vector2d> out;
-    for (int i = 0; i < tracking::kLandmarkCount; ++i) out.emplace_back(48 + offset(random), 48 + offset(random));
+    for (int i = 0; i < tega::landmarks::kLandmarkCount; ++i) out.emplace_back(48 + offset(random), 48 + offset(random));
     return out;
   }();
   return points;
@@ -75,20 +75,20 @@ const std::filesystem::path& pattern_predictor() {
   static const std::filesystem::path file = [] {
     std::mt19937 random(9);
     std::uniform_real_distribution<double> shift(-7, 7);
-    std::vector<tracking::LandmarkSample> samples;
+    std::vector<tega::landmarks::LandmarkSample> samples;
     for (int i = 0; i < 60; ++i) {
       const Eigen::Vector2d moved(shift(random), shift(random));
-      tracking::LandmarkSample sample{pattern_image(face_pattern(moved)), pattern_box(), {}};
+      tega::landmarks::LandmarkSample sample{pattern_image(face_pattern(moved)), pattern_box(), {}};
       for (const Eigen::Vector2d& p : pattern_landmarks()) sample.landmarks.push_back(p + moved);
       samples.push_back(std::move(sample));
     }
-    tracking::LandmarkTrainingOptions options;
+    tega::landmarks::LandmarkTrainingOptions options;
     options.cascade_depth = 8;
     options.trees_per_cascade_level = 50;
     options.oversampling = 10;
     options.add_mirrored_samples = false;  // the pattern has no mirror symmetry
     options.threads = 2;
-    tracking::train_landmark_predictor(samples, options, dir / "pattern.dat");
+    tega::landmarks::train_landmark_predictor(samples, options, dir / "pattern.dat");
     return dir / "pattern.dat";
   }();
   return file;

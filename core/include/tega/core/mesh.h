@@ -21,11 +21,16 @@
 #include <filesystem>
 #include <vector>
 
+#include "tega/core/geometry.h"
+
 namespace tega {
 
 using Vertices = Eigen::Matrix<float, Eigen::Dynamic, 3, Eigen::RowMajor>;
 using UVs = Eigen::Matrix<float, Eigen::Dynamic, 2, Eigen::RowMajor>;
 using Triangles = Eigen::Matrix<int32_t, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+// Every vertex moved by `transform`, each in double precision.
+Vertices transformed(const RigidTransform& transform, const Vertices& vertices);
 
 struct Mesh {
   Vertices positions;                    // V x 3

@@ -19,9 +19,12 @@
 #include "tega/tracking/head_model.h"
 #include "tega/tracking/options.h"
 
+namespace tega::landmarks {
+class LandmarkDetector;
+}
+
 namespace tega::tracking {
 
-class LandmarkDetector;
 class SurfaceQuery;
 struct ModelEyes;
 
@@ -90,19 +93,19 @@ Vertices pose_vertices(const HeadModel& model, const SubjectIdentity& subject, c
 // towards the cameras, upright as they are), refined by rigid ICP.
 RigidTransform initial_pose(const HeadModel& model, const Vertices& neutral, const FrameObservation& frame,
                             const std::vector<Camera>& cameras, const Options& options,
-                            const LandmarkDetector* landmarks);
+                            const landmarks::LandmarkDetector* landmarks);
 
 // Fits the subject (identity coefficients, then per-vertex detail) to
 // frames showing a neutral face. Throws tega::Error when it cannot.
 SubjectIdentity fit_identity(const HeadModel& model, const std::vector<FrameObservation>& frames,
                              const std::vector<Camera>& cameras, const Options& options,
-                             const LandmarkDetector* landmarks);
+                             const landmarks::LandmarkDetector* landmarks);
 
 // Tracks the frames of one take in order.
 class TakeTracker {
  public:
   TakeTracker(const HeadModel& model, const SubjectIdentity& subject, std::vector<Camera> cameras,
-              const Options& options, const LandmarkDetector* landmarks);
+              const Options& options, const landmarks::LandmarkDetector* landmarks);
   ~TakeTracker();
 
   // Fits the next frame, warm-started from the last accepted one. Where
@@ -131,7 +134,7 @@ class TakeTracker {
   const SubjectIdentity& subject_;
   std::vector<Camera> cameras_;
   Options options_;
-  const LandmarkDetector* landmarks_;
+  const landmarks::LandmarkDetector* landmarks_;
   std::vector<std::pair<int, int>> fit_edges_;
   std::unique_ptr<ModelEyes> eyes_;  // null: no eyelid term
   std::unique_ptr<Previous> previous_;

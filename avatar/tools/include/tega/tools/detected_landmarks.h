@@ -25,7 +25,7 @@ namespace tega::tools {
 // The 68 landmarks (pixels, the markup's order) of the face in the box of an 8-bit RGB image.
 using LandmarkPredictor = std::function<std::vector<Eigen::Vector2d>(const Image8&, const Eigen::AlignedBox2d&)>;
 
-// A dlib 68-point shape predictor (.dat; tracking's LandmarkDetector).
+// A dlib 68-point shape predictor (.dat; the landmarks library's LandmarkDetector).
 // Throws tega::Error naming the file when it is not one, and in a build
 // without dlib (the tracking/ folder's tega_landmarks) saying so.
 LandmarkPredictor load_landmark_predictor(const std::filesystem::path& file);
