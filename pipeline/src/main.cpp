@@ -6,6 +6,23 @@
 #include "tega/core/error.h"
 #include "tega/core/log.h"
 
+namespace {
+
+// The first argument that is not a flag: the command, since tega's own flags take no value.
+std::string first_command(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i)
+    if (argv[i][0] != '-') return argv[i];
+  return "";
+}
+
+bool has_command(const CLI::App& app, const std::string& name) {
+  for (const CLI::App* command : app.get_subcommands([](const CLI::App*) { return true; }))
+    if (command->check_name(name)) return true;
+  return false;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   CLI::App app{"tega: multi-camera head capture to animatable 3D Gaussian head avatars.\n"
                "Run `tega <command> --help` for a command's options."};
@@ -56,6 +73,13 @@ int main(int argc, char** argv) {
 #ifdef TEGA_HAVE_REPORT
   tega::cli::add_report_command(app);
 #endif
+
+  // CLI11 answers --help before it objects to an unknown command, so that
+  // `tega nosuch --help` would print the top help and succeed.
+  if (const std::string command = first_command(argc, argv); !command.empty() && !has_command(app, command)) {
+    std::cerr << "tega: error: unknown command '" << command << "' (`tega --help` lists the commands)\n";
+    return 1;
+  }
 
   try {
     app.parse(argc, argv);

@@ -21,6 +21,14 @@ TEST(Cli, NoCommandIsAnError) {
   EXPECT_NE(r.exit_code, 0);
 }
 
+TEST(Cli, UnknownCommandIsAnErrorEvenWhenAskedForHelp) {
+  for (const char* arguments : {"nosuch --help", "nosuch", "-v nosuch --help"}) {
+    const auto r = run_tega(arguments);
+    EXPECT_NE(r.exit_code, 0) << arguments << "\n" << r.output;
+    EXPECT_NE(r.output.find("unknown command 'nosuch'"), std::string::npos) << arguments << "\n" << r.output;
+  }
+}
+
 TEST(Cli, UnknownFlagIsAnError) {
   const auto r = run_tega("dataset check --data x --no-such-flag");
   EXPECT_NE(r.exit_code, 0);
@@ -33,7 +41,9 @@ TEST(Cli, EveryCommandDescribesEveryFlag) {
                               "capture session", "capture validate", "calibrate", "calibrate board", "mvs",
                               "mvs photos", "mvs mesh-workspace", "track", "landmarks train", "inspect"}) {
     const auto r = run_tega(std::string(command) + " --help");
-    if (r.output.find("could not be matched") != std::string::npos) continue;  // command not built here
+    if (r.output.find("unknown command") != std::string::npos ||
+        r.output.find("could not be matched") != std::string::npos)
+      continue;  // command not built here
     EXPECT_EQ(r.exit_code, 0) << command << "\n" << r.output;
     // CLI11 prints each option on its own line: the flag, its type in capitals
     // (TEXT, INT:POSITIVE=1, REQUIRED ...), then its description. A flag
