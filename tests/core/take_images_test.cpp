@@ -1,10 +1,13 @@
-// Raw Bayer mosaics demosaiced at full and half size, against the colour
-// image they were sampled from.
+// A take's images made RGB by its pixel format: raw Bayer mosaics demosaiced
+// at full and half size, against the colour image they were sampled from.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <string>
+#include <vector>
 
+#include "tega/core/downsample.h"
 #include "tega/core/error.h"
 #include "tega/core/take_images.h"
 
@@ -31,11 +34,12 @@ Image8 mosaic(const std::string& pattern, int width, int height) {
   return raw;
 }
 
+const struct {
+  std::string format, quad;
+} kPatterns[] = {{"BayerRG8", "RGGB"}, {"BayerBG8", "BGGR"}, {"BayerGB8", "GBRG"}, {"BayerGR8", "GRBG"}};
+
 TEST(Debayer, HalfSizeIsTheColourAtEachQuadsCentre) {
-  const struct {
-    std::string format, quad;
-  } patterns[] = {{"BayerRG8", "RGGB"}, {"BayerBG8", "BGGR"}, {"BayerGB8", "GBRG"}, {"BayerGR8", "GRBG"}};
-  for (const auto& p : patterns) {
+  for (const auto& p : kPatterns) {
     const Image8 raw = mosaic(p.quad, 64, 48);
     const Image8 half = debayer_half(raw, p.format);
     ASSERT_EQ(half.width, 32);
@@ -66,6 +70,70 @@ TEST(Debayer, HalfSizeAgreesWithFullSizeHalved) {
         worst = std::max(worst, std::abs(quad_mean - half.at(x, y, c)));
       }
   EXPECT_LE(worst, 2);
+}
+
+// GenICam names a mosaic by its first row, OpenCV by its second: each of the
+// four patterns must come out as the colour it sampled.
+TEST(Debayer, FullSizeIsTheColourAtEveryPixelForEveryPattern) {
+  for (const auto& p : kPatterns) {
+    const Image8 rgb = debayer(mosaic(p.quad, 64, 48), p.format);
+    ASSERT_EQ(rgb.channels, 3);
+    int worst = 0;
+    for (int y = 2; y < rgb.height - 2; ++y)
+      for (int x = 2; x < rgb.width - 2; ++x)
+        for (int c = 0; c < 3; ++c)
+          worst = std::max(worst, int(std::abs(rgb.at(x, y, c) - ramp(c, x, y)) + 0.5));
+    EXPECT_LE(worst, 2) << p.format;
+  }
+}
+
+TEST(Debayer, GreyIsTheLumaOfTheColourForEveryPattern) {
+  for (const auto& p : kPatterns) {
+    const Image8 grey = debayer_grey(mosaic(p.quad, 64, 48), p.format);
+    ASSERT_EQ(grey.channels, 1);
+    int worst = 0;
+    for (int y = 2; y < grey.height - 2; ++y)
+      for (int x = 2; x < grey.width - 2; ++x) {
+        const double luma = 0.299 * ramp(0, x, y) + 0.587 * ramp(1, x, y) + 0.114 * ramp(2, x, y);
+        worst = std::max(worst, int(std::abs(grey.at(x, y, 0) - luma) + 0.5));
+      }
+    EXPECT_LE(worst, 2) << p.format;
+  }
+}
+
+// Capture stores 16-bit mosaics (Bayer*12 and *16) demosaiced the same way.
+TEST(Debayer, SixteenBitMosaicsDemosaicAsEightBitOnes) {
+  const Image8 raw = mosaic("GRBG", 32, 24);
+  std::vector<uint16_t> raw16(raw.pixels.size()), rgb16(raw.pixels.size() * 3);
+  for (size_t i = 0; i < raw.pixels.size(); ++i) raw16[i] = uint16_t(raw.pixels[i] * 256);
+  demosaic(raw16.data(), raw.width, raw.height, 2, "BayerGR16", rgb16.data());
+  const Image8 rgb = debayer(raw, "BayerGR8");
+  int worst = 0;
+  for (size_t i = 0; i < rgb16.size(); ++i) worst = std::max(worst, std::abs(int(rgb16[i]) - 256 * rgb.pixels[i]));
+  EXPECT_LE(worst, 256);
+}
+
+TEST(TakeImages, RecordedImagesBecomeRgbByThePixelFormat) {
+  Image8 colour(4, 2, 3), grey(4, 2, 1);
+  for (size_t i = 0; i < colour.pixels.size(); ++i) colour.pixels[i] = uint8_t(10 * i);
+  for (size_t i = 0; i < grey.pixels.size(); ++i) grey.pixels[i] = uint8_t(30 * i);
+  EXPECT_EQ(recorded_rgb(colour, "RGB8", "a.png").pixels, colour.pixels);
+  const Image8 swapped = recorded_rgb(colour, "BGR8", "a.png");
+  EXPECT_EQ(swapped.at(1, 1, 0), colour.at(1, 1, 2));
+  EXPECT_EQ(swapped.at(1, 1, 2), colour.at(1, 1, 0));
+  const Image8 mono = recorded_rgb(grey, "Mono8", "a.png");
+  EXPECT_EQ(mono.at(2, 1, 1), grey.at(2, 1, 0));
+  // An even factor demosaics a raw mosaic straight to half size.
+  const Image8 raw = mosaic("RGGB", 64, 48);
+  EXPECT_EQ(recorded_rgb(raw, "BayerRG8", "a.png", 2).pixels, debayer_half(raw, "BayerRG8").pixels);
+  EXPECT_EQ(recorded_rgb(raw, "BayerRG8", "a.png", 4).pixels,
+            box_downsample_dropping_remainder(debayer_half(raw, "BayerRG8"), 2).pixels);
+  try {
+    recorded_rgb(colour, "Mono8", "takes/t/cam00/000000.png");
+    FAIL() << "a 3-channel image taken as Mono8";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("cam00/000000.png"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Debayer, RejectsUnknownFormatsAndOddSizes) {
