@@ -148,9 +148,8 @@ ImageF grey_of(const Image8& image) {
   return grey;
 }
 
-Image8 recorded_rgb(const Image8& recorded, const std::string& pixel_format, const std::filesystem::path& file,
+Image8 recorded_rgb(const Image8& recorded, const std::string& format, const std::filesystem::path& file,
                     int downsample) {
-  const std::string& format = pixel_format;
   if (is_bayer(format) && recorded.channels == 1) {
     if (downsample % 2 == 0) return box_downsample_dropping_remainder(debayer_half(recorded, format), downsample / 2);
     return box_downsample_dropping_remainder(debayer(recorded, format), downsample);

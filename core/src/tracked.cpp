@@ -70,7 +70,7 @@ void write_tracked_subject(const TrackedSubject& subject, const fs::path& file) 
   nlohmann::json j;
   j["model"] = subject.model.string();
   j["model_vertices"] = subject.neutral.num_vertices();
-  j["identity"] = subject.identity.empty() ? nlohmann::json::object() : nlohmann::json(subject.identity);
+  j["identity"] = subject.identity;
   j["neutral"] = mesh_file.filename().string();
   if (!subject.open_eyes_covered.empty()) j["open_eyes_covered"] = subject.open_eyes_covered;
   j["eyeball_vertex_runs"] = vertex_runs(subject.eyeball_vertices);
@@ -117,7 +117,7 @@ void write_tracked_frame(const fs::path& take_dir, const TrackedFrame& frame, co
     const auto m = frame.head_to_world.matrix();
     j["head_to_world"] = nlohmann::json::array();
     for (int r = 0; r < 3; ++r) j["head_to_world"].push_back({m(r, 0), m(r, 1), m(r, 2), m(r, 3)});
-    j["expression"] = frame.expression.empty() ? nlohmann::json::object() : nlohmann::json(frame.expression);
+    j["expression"] = frame.expression;
     j["residuals"] = frame.residuals;
   }
   if (mesh) {

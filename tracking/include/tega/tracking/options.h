@@ -87,7 +87,7 @@ struct LandmarkOptions {
     v("min_views", min_views, "Views a landmark needs to be triangulated for the first frame's pose.");
     v("detector_boxes", detector_boxes,
       "Find faces with dlib's frontal face detector (the boxes dlib's own predictor was trained on) instead of "
-      "around the projected model's landmarks (the boxes landmarks::train_landmark_predictor uses).");
+      "around the projected model's landmarks (the boxes train_landmark_predictor uses).");
     v("ignored_points", ignored_points,
       "Landmarks (0-based, iBUG 68-point numbering) the per-frame fit leaves out, e.g. [36, 37, ..., 47] for the "
       "eyelids with dlib's stock predictor, whose eye points do not follow closing lids (docs/tracking.md).");
