@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "commands.h"
+#include "heap.h"
 #include "tega/core/error.h"
 #include "tega/core/log.h"
 
@@ -24,6 +25,7 @@ bool has_command(const CLI::App& app, const std::string& name) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  tega::cli::keep_freed_memory_for_reuse();
   CLI::App app{"tega: multi-camera head capture to animatable 3D Gaussian head avatars.\n"
                "Run `tega <command> --help` for a command's options."};
   app.get_formatter()->column_width(44);

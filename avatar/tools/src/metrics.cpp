@@ -84,19 +84,23 @@ double psnr(const at::Tensor& a, const at::Tensor& b, const at::Tensor& mask) {
 
 at::Tensor ssim_map(const at::Tensor& a_in, const at::Tensor& b_in) {
   check_pair(a_in, b_in);
-  const at::Tensor a = a_in.to(at::kDouble).unsqueeze(0), b = b_in.to(at::kDouble).unsqueeze(0);
-  const int64_t channels = a.size(1);
+  const at::Tensor a = a_in.to(at::kDouble), b = b_in.to(at::kDouble);
+  const int64_t channels = a.size(0);
   const at::Tensor g = gaussian_taps(a.options());
-  const at::Tensor window = at::outer(g, g).expand({channels, 1, kWindow, kWindow}).contiguous();
-  const auto blur = [&](const at::Tensor& t) {
-    return at::conv2d(t, window, {}, /*stride=*/1, /*padding=*/kWindow / 2, /*dilation=*/1, /*groups=*/channels);
-  };
-  const at::Tensor mu_a = blur(a), mu_b = blur(b);
-  const at::Tensor var_a = blur(a * a) - mu_a * mu_a, var_b = blur(b * b) - mu_b * mu_b;
-  const at::Tensor cov = blur(a * b) - mu_a * mu_b;
+  // The window is separable, zero padding too: 22 taps a pixel instead of 121, and the five
+  // blurred images as one batch of one-channel images rather than a grouped convolution,
+  // which libtorch's CPU runs through a dense im2col (3.5 s a 640 x 480 view).
+  const at::Tensor stacked = at::cat({a, b, a * a, b * b, a * b}).unsqueeze(1);  // [5C,1,H,W]
+  const int64_t r = kWindow / 2, no_stride[] = {1, 1}, down_pad[] = {r, 0}, across_pad[] = {0, r};
+  const at::Tensor down = at::conv2d(stacked, g.view({1, 1, kWindow, 1}), at::Tensor(), no_stride, down_pad);
+  const std::vector<at::Tensor> blurred =
+      at::conv2d(down, g.view({1, 1, 1, kWindow}), at::Tensor(), no_stride, across_pad).squeeze(1).split(channels);
+  const at::Tensor &mu_a = blurred[0], &mu_b = blurred[1];
+  const at::Tensor var_a = blurred[2] - mu_a * mu_a, var_b = blurred[3] - mu_b * mu_b;
+  const at::Tensor cov = blurred[4] - mu_a * mu_b;
   const at::Tensor map = ((2 * mu_a * mu_b + kC1) * (2 * cov + kC2)) /
                          ((mu_a * mu_a + mu_b * mu_b + kC1) * (var_a + var_b + kC2));
-  return map[0].mean(0);
+  return map.mean(0);
 }
 
 double ssim(const at::Tensor& a, const at::Tensor& b) { return ssim_map(a, b).mean().item<double>(); }
