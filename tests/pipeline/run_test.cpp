@@ -331,7 +331,7 @@ TEST(TegaRun, MeshesEveryPerformanceFrameWithTheCalibratedRig) {
 }
 
 TEST(TegaRun, TheShippedConfigsAreValidGraphs) {
-  for (const char* name : {"demo.yaml", "studio13-capture.yaml", "studio-raw.yaml", "studio-raw-640.yaml"}) {
+  for (const char* name : {"demo.yaml", "studio13-capture.yaml", "studio-raw.yaml"}) {
     TempDir dir;
     const auto r = run_tega({"status", (fs::path(TEGA_STUDIO_CONFIGS) / name).string(), "--json"}, dir.path());
     EXPECT_EQ(r.exit_code, 0) << name << ": " << r.output;

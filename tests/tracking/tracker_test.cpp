@@ -175,7 +175,7 @@ TEST(Tracker, FindsAHeadTurnedAwayFromTheRigWithoutLandmarks) {
 }
 
 // Key poses, not video: the first frames of the raw chain's second subject
-// (docs/pipeline.md: studio-raw-640.yaml with head_identity
+// (docs/pipeline.md: studio-raw.yaml at 640 x 480 with head_identity
 // [-0.5, 0.7, -0.3, 0.6, 0.2], seed 7; poses and expressions from its
 // ground_truth/expressions/frames.json), the head turning 13-16 degrees and
 // moving 12-17 mm from frame to frame. ICP from the previous pose alone can
