@@ -5,11 +5,14 @@
 #include <atomic>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <thread>
 
 #include "available_commands.h"
 #include "commands.h"
 #include "tega/core/error.h"
+#include "tega/core/log.h"
+#include "tega/pipeline/gpus.h"
 #include "tega/pipeline/local_executor.h"
 #include "tega/pipeline/orchestrator.h"
 #include "tega/pipeline/slurm_executor.h"
@@ -48,26 +51,44 @@ struct RunArguments {
   std::string config, workspace;
   std::vector<std::string> only, from, force;
   int jobs = 0;
+  std::optional<std::string> gpus;
   std::string executor = "local";
   pipeline::SlurmOptions slurm;
 };
 
-std::unique_ptr<pipeline::Executor> make_executor(const RunArguments& args, const CLI::App& cmd) {
+// --gpus, else the config's `gpus`, else every GPU of the machine.
+std::vector<std::string> local_gpus(const RunArguments& args, const pipeline::PipelineConfig& config) {
+  if (args.gpus) return pipeline::parse_gpu_list(*args.gpus, "--gpus");
+  if (config.gpus) return *config.gpus;
+  return pipeline::machine_gpus();
+}
+
+std::unique_ptr<pipeline::Executor> make_executor(const RunArguments& args, const CLI::App& cmd,
+                                                  const pipeline::PipelineConfig& config) {
   if (args.executor == "slurm") {
-    if (cmd.count("--jobs") > 0) throw Error("--jobs applies to --executor local only (Slurm decides how many jobs run)");
+    for (const char* local_only : {"--jobs", "--gpus"}) {
+      if (cmd.count(local_only) > 0)
+        throw Error(std::string(local_only) + " applies to --executor local only (Slurm decides where jobs run)");
+    }
     return std::make_unique<pipeline::SlurmExecutor>(args.slurm);
   }
   for (const char* slurm_only : {"--partition", "--gpus-per-job", "--max-requeues"}) {
     if (cmd.count(slurm_only) > 0) throw Error(std::string(slurm_only) + " applies to --executor slurm only");
   }
   const int jobs = args.jobs > 0 ? args.jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  return std::make_unique<pipeline::LocalExecutor>(jobs);
+  std::vector<std::string> gpus = local_gpus(args, config);
+  if (!gpus.empty()) {
+    std::string listed;
+    for (const auto& gpu : gpus) listed += (listed.empty() ? "" : ", ") + gpu;
+    logging::info("tega run: GPU shards spread over GPU %s", listed.c_str());
+  }
+  return std::make_unique<pipeline::LocalExecutor>(jobs, std::move(gpus));
 }
 
 void run(const RunArguments& args, const CLI::App& cmd, const CLI::App& root) {
-  const std::unique_ptr<pipeline::Executor> executor = make_executor(args, cmd);
   pipeline::PipelineConfig config = pipeline::load_pipeline_config(args.config);
   if (!args.workspace.empty()) config.workspace = fs::absolute(args.workspace).lexically_normal();
+  const std::unique_ptr<pipeline::Executor> executor = make_executor(args, cmd, config);
   const pipeline::StageGraph graph(std::move(config),
                                    [&](const std::vector<std::string>& path) { return has_subcommand(root, path); });
 
@@ -101,7 +122,11 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--from", args->from, "Re-run this stage and every stage downstream of it (repeatable).");
   cmd->add_option("--force", args->force, "Re-run this stage even where it is done (repeatable).");
   cmd->add_option("--jobs", args->jobs, "CPU shards run in parallel (default: one per hardware thread); "
-                                        "GPU shards run one at a time per device.");
+                                        "GPU shards run one at a time per GPU.");
+  cmd->add_option("--gpus", args->gpus,
+                  "GPUs the GPU shards (a stage's device: cuda) spread over, each shard pinned to one with "
+                  "CUDA_VISIBLE_DEVICES: indices or UUIDs, e.g. 0,1,3 (default: the config's `gpus`, else every GPU "
+                  "of the machine; docs/pipeline.md#several-gpus).");
   cmd->add_option("--workspace", args->workspace, "Use this workspace instead of the config's.");
   cmd->add_option("--executor", args->executor,
                   "Where shards run: local (child processes) or slurm (a batch job each; the workspace must be on "

@@ -43,6 +43,18 @@ TEST(PipelineConfig, WithoutSubjectsHasOneDefaultSubject) {
   EXPECT_EQ(c.subjects[0].name, "default");
 }
 
+TEST(PipelineConfig, NamesTheGpusOfALocalRunOrLeavesThemToTheMachine) {
+  EXPECT_FALSE(parse("workspace: ws\nstages:\n  synth:\n").gpus);
+  const auto c = parse("workspace: ws\ngpus: [0, 2, GPU-5e1f]\nstages:\n  synth:\n");
+  ASSERT_TRUE(c.gpus);
+  EXPECT_EQ(*c.gpus, (std::vector<std::string>{"0", "2", "GPU-5e1f"}));
+  EXPECT_NE(error_of([] { parse("workspace: ws\ngpus: [1, 1]\nstages:\n  synth:\n"); }).find("listed twice"),
+            std::string::npos);
+  EXPECT_EQ(*parse("workspace: ws\ngpus: 1\nstages:\n  synth:\n").gpus, std::vector<std::string>{"1"});
+  EXPECT_NE(error_of([] { parse("workspace: ws\ngpus: {first: 0}\nstages:\n  synth:\n"); }).find("gpus"),
+            std::string::npos);
+}
+
 TEST(PipelineConfig, OptionsAreCanonicalWhateverTheirOrderAndLayout) {
   const auto a = parse("workspace: ws\nstages:\n  synth:\n    options:\n      seed: 1\n      studio: {width: 64, cameras: 2}\n");
   const auto b = parse("workspace: ws\nstages:\n  synth: {options: {studio: {cameras: 2, width: 64}, seed: 1}}\n");
@@ -92,7 +104,7 @@ TEST(PipelineConfig, OptionsBecomeFlagsForCommandsWithoutAConfigFile) {
 
 TEST(PipelineConfig, UnknownKeysAreErrorsNamingTheFileAndTheKnownKeys) {
   EXPECT_EQ(error_of([] { parse("workspace: ws\nstage: {}\n"); }),
-            "/cfg/p.yaml: unknown key 'stage' (line 2); known keys: description, workspace, subjects, stages");
+            "/cfg/p.yaml: unknown key 'stage' (line 2); known keys: description, workspace, subjects, stages, gpus");
   EXPECT_EQ(error_of([] { parse("workspace: ws\nstages:\n  synth: {option: {}}\n"); }),
             "/cfg/p.yaml: unknown key 'stages.synth.option' (line 3); known keys of 'stages.synth': kind, after, "
             "options, options_file");

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+#include <optional>
+
 #include "tega/core/files.h"
 #include "test_support.h"
 
@@ -67,6 +70,82 @@ TEST(LocalExecutor, SerializesJobsPerGpuDeviceButNotAcrossDevices) {
   for (const auto& r : results) EXPECT_TRUE(r.succeeded) << r.id << ": " << r.failure;
 }
 
+// Records the GPUs the job sees in <id>.gpu, holding the lock of that GPU meanwhile.
+std::string record_gpu(const std::string& id, const std::string& then = "sleep 0.2") {
+  return "echo \"${CUDA_VISIBLE_DEVICES-unset}\" > " + id + ".gpu; mkdir \"lock-$CUDA_VISIBLE_DEVICES\" || exit 3; " +
+         then + "; rmdir \"lock-$CUDA_VISIBLE_DEVICES\"";
+}
+
+std::string gpu_seen(const test::TempDir& dir, const std::string& id) {
+  std::string text = read_text_file(dir / (id + ".gpu"));
+  while (!text.empty() && text.back() == '\n') text.pop_back();
+  return text;
+}
+
+// Sets an environment variable for a test's duration.
+class ScopedEnvironment {
+ public:
+  ScopedEnvironment(const char* name, const char* value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old;
+    ::setenv(name, value, 1);
+  }
+  ~ScopedEnvironment() { old_ ? (void)::setenv(name_, old_->c_str(), 1) : (void)::unsetenv(name_); }
+
+ private:
+  const char* name_;
+  std::optional<std::string> old_;
+};
+
+TEST(LocalExecutor, SpreadsCudaJobsOverItsGpusEachPinnedToOneOfThem) {
+  test::TempDir dir;
+  const ScopedEnvironment machine("CUDA_VISIBLE_DEVICES", "0,1,2,3");
+  LocalExecutor executor(1, {"2", "GPU-7f3a"});  // one CPU slot: GPU jobs do not take CPU slots
+  // a and b only succeed when they run at the same time: on two GPUs at once.
+  executor.submit(shell_job("a", record_gpu("a", rendezvous("a.started", "b.started")), dir, "cuda"));
+  executor.submit(shell_job("b", record_gpu("b", rendezvous("b.started", "a.started")), dir, "cuda"));
+  for (const char* id : {"c", "d", "e"}) executor.submit(shell_job(id, record_gpu(id), dir, "cuda"));
+  executor.submit(shell_job("cpu", "sleep 0.1", dir));
+  const auto results = wait_for_all(executor, 30s);
+  ASSERT_EQ(results.size(), 6u);
+  for (const auto& r : results) EXPECT_TRUE(r.succeeded) << r.id << ": " << r.failure;
+  EXPECT_NE(gpu_seen(dir, "a"), gpu_seen(dir, "b"));
+  for (const char* id : {"a", "b", "c", "d", "e"}) {
+    const std::string gpu = gpu_seen(dir, id);
+    EXPECT_TRUE(gpu == "2" || gpu == "GPU-7f3a") << id << " saw CUDA_VISIBLE_DEVICES=" << gpu;
+    EXPECT_NE(read_text_file(dir / ("logs/" + std::string(id) + ".log")).find(" on GPU " + gpu + ":"),
+              std::string::npos);
+  }
+}
+
+TEST(LocalExecutor, WithoutGpusRunsCudaJobsOneAtATimeUnpinned) {
+  test::TempDir dir;
+  const ScopedEnvironment machine("CUDA_VISIBLE_DEVICES", "5,6");
+  LocalExecutor executor(4);
+  for (const char* id : {"a", "b", "c"}) executor.submit(shell_job(id, record_gpu(id), dir, "cuda"));
+  const auto results = wait_for_all(executor, 30s);
+  ASSERT_EQ(results.size(), 3u);
+  for (const auto& r : results) EXPECT_TRUE(r.succeeded) << r.id << ": " << r.failure;  // the lock held
+  for (const char* id : {"a", "b", "c"}) EXPECT_EQ(gpu_seen(dir, id), "5,6") << id;
+}
+
+TEST(LocalExecutor, AJobForOneDeviceWaitsForThePinnedJobOnItAndRunsUnpinned) {
+  test::TempDir dir;
+  const ScopedEnvironment machine("CUDA_VISIBLE_DEVICES", "0,1");
+  LocalExecutor executor(4, {"1"});
+  // pooled holds GPU 1 until a job on GPU 0 has started beside it; given, for GPU 1, must wait.
+  executor.submit(shell_job("pooled",
+                            "mkdir lock || exit 3; " + rendezvous("pooled.started", "other.started") +
+                                "; sleep 0.2; rmdir lock",
+                            dir, "cuda"));
+  executor.submit(shell_job("given", "mkdir lock || exit 3; echo $CUDA_VISIBLE_DEVICES > given.gpu; rmdir lock", dir,
+                            "cuda:1"));
+  executor.submit(shell_job("other", rendezvous("other.started", "pooled.started"), dir, "cuda:0"));
+  const auto results = wait_for_all(executor, 30s);
+  ASSERT_EQ(results.size(), 3u);
+  for (const auto& r : results) EXPECT_TRUE(r.succeeded) << r.id << ": " << r.failure;
+  EXPECT_EQ(gpu_seen(dir, "given"), "0,1");  // cuda:1 names the machine's device 1: not pinned
+}
+
 TEST(LocalExecutor, ReportsFailuresAndAppendsOutputToTheLog) {
   test::TempDir dir;
   LocalExecutor executor(2);
@@ -90,7 +169,7 @@ TEST(LocalExecutor, ReportsFailuresAndAppendsOutputToTheLog) {
 
 TEST(LocalExecutor, CancelStopsRunningJobsAndDropsQueuedOnes) {
   test::TempDir dir;
-  LocalExecutor executor(1, 2s);
+  LocalExecutor executor(1, {}, 2s);
   executor.submit(shell_job("sleeper", "touch started; sleep 60", dir));
   executor.submit(shell_job("queued", "touch queued-ran", dir));
   while (!std::filesystem::exists(dir / "started")) executor.wait(20ms);

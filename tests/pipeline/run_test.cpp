@@ -330,6 +330,18 @@ TEST(TegaRun, MeshesEveryPerformanceFrameWithTheCalibratedRig) {
   EXPECT_NE(log.find("0 frame(s) meshed, 2 already done"), std::string::npos) << log;
 }
 
+TEST(TegaRun, ABadGpuListIsAnErrorBeforeAnythingRuns) {
+  TempDir dir;
+  write_text(dir / "p.yaml", "workspace: ws\nstages:\n  check: {kind: dataset_check}\n");
+  const auto twice = run_tega({"run", (dir / "p.yaml").string(), "--gpus", "0,1,0"}, dir.path());
+  EXPECT_NE(twice.exit_code, 0);
+  EXPECT_NE(twice.output.find("--gpus: GPU '0' is listed twice"), std::string::npos) << twice.output;
+  const auto slurm = run_tega({"run", (dir / "p.yaml").string(), "--executor", "slurm", "--gpus", "0"}, dir.path());
+  EXPECT_NE(slurm.exit_code, 0);
+  EXPECT_NE(slurm.output.find("--gpus applies to --executor local only"), std::string::npos) << slurm.output;
+  EXPECT_FALSE(fs::exists(dir / "ws"));
+}
+
 TEST(TegaRun, TheShippedConfigsAreValidGraphs) {
   for (const char* name : {"demo.yaml", "studio13-capture.yaml", "studio-raw.yaml"}) {
     TempDir dir;

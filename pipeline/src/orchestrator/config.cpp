@@ -1,4 +1,5 @@
 #include "tega/pipeline/config.h"
+#include "tega/pipeline/gpus.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -210,7 +211,11 @@ PipelineConfig parse_pipeline_config(const std::string& text, const fs::path& so
 
   const YAML::Node stages = root["stages"];
   std::set<std::string> stage_names;
-  std::vector<std::string> known_keys = {"description", "workspace", "subjects", "stages"};
+  std::vector<std::string> known_keys = {"description", "workspace", "subjects", "stages", "gpus"};
+  if (root["gpus"]) {
+    config.gpus = r.string_list(root["gpus"], "gpus");
+    check_gpu_list(*config.gpus, source.string() + ": gpus");
+  }
   if (stages && stages.IsMap()) {
     for (const auto& e : stages) {
       const auto name = e.first.as<std::string>();

@@ -6,7 +6,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+extern char** environ;
+
+#include <algorithm>
 #include <cstring>
+#include <string_view>
 #include <string>
 #include <thread>
 
@@ -28,8 +32,25 @@ std::string describe_exit(int status) {
   return "ended with wait status " + std::to_string(status);
 }
 
+// This process's environment with CUDA_VISIBLE_DEVICES set to `gpu` ("" leaves it as it is).
+std::vector<std::string> child_environment(const std::string& gpu) {
+  static constexpr std::string_view kVisible = "CUDA_VISIBLE_DEVICES=";
+  std::vector<std::string> environment;
+  for (char** entry = environ; *entry != nullptr; ++entry)
+    if (gpu.empty() || std::string_view(*entry).substr(0, kVisible.size()) != kVisible) environment.push_back(*entry);
+  if (!gpu.empty()) environment.push_back(std::string(kVisible) + gpu);
+  return environment;
+}
+
+std::vector<char*> null_terminated(const std::vector<std::string>& strings) {
+  std::vector<char*> pointers;
+  for (const auto& s : strings) pointers.push_back(const_cast<char*>(s.c_str()));
+  pointers.push_back(nullptr);
+  return pointers;
+}
+
 // Between fork and exec only async-signal-safe calls are allowed.
-[[noreturn]] void exec_child(pid_t parent, int log_fd, const char* directory, char* const* argv) {
+[[noreturn]] void exec_child(pid_t parent, int log_fd, const char* directory, char* const* argv, char* const* envp) {
   ::setpgid(0, 0);  // its own group: a terminal's Ctrl-C reaches the orchestrator, which stops the jobs
   ::prctl(PR_SET_PDEATHSIG, SIGKILL);
   if (::getppid() != parent) ::_exit(125);  // the orchestrator died before prctl took effect
@@ -45,7 +66,7 @@ std::string describe_exit(int status) {
     (void)!::write(STDERR_FILENO, message, sizeof message - 1);
     ::_exit(126);
   }
-  ::execv(argv[0], argv);
+  ::execve(argv[0], argv, envp);
   const char message[] = "tega run: cannot execute the shard's command\n";
   (void)!::write(STDERR_FILENO, message, sizeof message - 1);
   ::_exit(127);
@@ -53,55 +74,66 @@ std::string describe_exit(int status) {
 
 }  // namespace
 
-LocalExecutor::LocalExecutor(int cpu_slots, std::chrono::milliseconds stop_grace)
-    : cpu_slots_(std::max(1, cpu_slots)), stop_grace_(stop_grace) {}
+LocalExecutor::LocalExecutor(int cpu_slots, std::vector<std::string> gpus, std::chrono::milliseconds stop_grace)
+    : cpu_slots_(std::max(1, cpu_slots)), gpus_(std::move(gpus)), stop_grace_(stop_grace) {}
 
 LocalExecutor::~LocalExecutor() { cancel_all(); }
 
 void LocalExecutor::submit(Job job) { queue_.push_back(std::move(job)); }
 
-pid_t LocalExecutor::launch(const Job& job) {
+pid_t LocalExecutor::launch(const Job& job, const std::string& pinned_gpu) {
   fs::create_directories(job.log_file.parent_path());
   const int log_fd = ::open(job.log_file.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   if (log_fd < 0) throw Error(job.log_file, "cannot be opened for writing");
-  std::string header = "=== " + utc_now() + " " + job.id + ":";
+  std::string header = "=== " + utc_now() + " " + job.id + (pinned_gpu.empty() ? "" : " on GPU " + pinned_gpu) + ":";
   for (const auto& a : job.argv) header += " " + a;
   header += "\n";
   (void)!::write(log_fd, header.data(), header.size());
 
-  std::vector<char*> argv;
-  for (const auto& a : job.argv) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
+  // Built before fork: between fork and exec nothing may allocate.
+  std::vector<char*> argv = null_terminated(job.argv);
+  const std::vector<std::string> environment = child_environment(pinned_gpu);
+  std::vector<char*> envp = null_terminated(environment);
   const std::string directory = job.working_directory.string();
   const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
-  if (pid == 0) exec_child(parent, log_fd, directory.c_str(), argv.data());
+  if (pid == 0) exec_child(parent, log_fd, directory.c_str(), argv.data(), envp.data());
   ::close(log_fd);
   if (pid < 0) throw Error(std::string("cannot start ") + job.id + ": fork failed: " + std::strerror(errno));
   ::setpgid(pid, pid);  // also here, so that the group exists before any kill(-pid)
   return pid;
 }
 
+std::optional<std::pair<std::string, bool>> LocalExecutor::free_gpu(const Job& job) const {
+  const auto held = [&](const std::string& gpu) {
+    return std::any_of(running_.begin(), running_.end(), [&](const auto& r) { return r.second.gpu == gpu; });
+  };
+  const std::string& device = job.resources.gpu_device;
+  if (device == "cuda" && !gpus_.empty()) {
+    for (const std::string& gpu : gpus_)
+      if (!held(gpu)) return std::make_pair(gpu, true);
+    return std::nullopt;
+  }
+  const std::string gpu = device.rfind("cuda:", 0) == 0 ? device.substr(5) : device;
+  if (held(gpu)) return std::nullopt;
+  return std::make_pair(gpu, false);
+}
+
 void LocalExecutor::start_ready_jobs(std::vector<JobResult>& results) {
   int cpu_running = 0;
-  for (const auto& [pid, r] : running_) cpu_running += r.job.resources.gpu_device.empty() ? 1 : 0;
+  for (const auto& [pid, r] : running_) cpu_running += r.gpu.empty() ? 1 : 0;
   for (auto it = queue_.begin(); it != queue_.end();) {
-    const std::string& device = it->resources.gpu_device;
-    bool free = false;
-    if (device.empty()) {
-      free = cpu_running < cpu_slots_;
-    } else {
-      free = true;
-      for (const auto& [pid, r] : running_) free = free && r.job.resources.gpu_device != device;
-    }
-    if (!free) {
+    const bool cpu_job = it->resources.gpu_device.empty();
+    std::optional<std::pair<std::string, bool>> gpu;
+    if (cpu_job ? cpu_running >= cpu_slots_ : !(gpu = free_gpu(*it))) {
       ++it;
       continue;
     }
     try {
-      const pid_t pid = launch(*it);
-      running_[pid] = {std::move(*it), Clock::now()};
-      cpu_running += device.empty() ? 1 : 0;
+      const auto& [held, pinned] = cpu_job ? std::make_pair(std::string(), false) : *gpu;
+      const pid_t pid = launch(*it, pinned ? held : "");
+      running_[pid] = {std::move(*it), held, pinned, Clock::now()};
+      cpu_running += cpu_job ? 1 : 0;
     } catch (const std::exception& e) {
       results.push_back({it->id, false, std::string("could not start: ") + e.what(), 0});
     }

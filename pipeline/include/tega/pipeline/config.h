@@ -35,6 +35,9 @@ struct PipelineConfig {
   std::filesystem::path workspace;
   std::vector<SubjectConfig> subjects;  // never empty: one subject "default" when the config has none
   std::vector<StageConfig> stages;      // in file order
+  // `gpus: [0, 1]`: the GPUs a local run spreads its GPU shards over (CUDA_VISIBLE_DEVICES
+  // entries, gpus.h); unset: every GPU of the machine. `tega run --gpus` overrides it.
+  std::optional<std::vector<std::string>> gpus;
 
   // The options of `stage` for `subject`: the stage's, with the subject's overlay merged in.
   std::string options_for(const StageConfig& stage, const SubjectConfig& subject) const;

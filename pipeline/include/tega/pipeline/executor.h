@@ -13,8 +13,9 @@
 namespace tega::pipeline {
 
 struct Resources {
-  // "" for a CPU job; else the GPU device it uses ("cuda", "cuda:1"), which
-  // runs one job at a time.
+  // "" for a CPU job; else the GPU device it uses. "cuda": any one GPU, which the executor
+  // chooses (the local one pins the job to it with CUDA_VISIBLE_DEVICES); "cuda:1": that
+  // device, as the machine numbers it. A GPU runs one job at a time.
   std::string gpu_device;
 };
 

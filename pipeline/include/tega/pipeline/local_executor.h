@@ -1,6 +1,10 @@
 #pragma once
 // Runs jobs as child processes of this one: up to `cpu_slots` CPU jobs at
-// once, and one job at a time per GPU device. Children die with the
+// once, and one job at a time per GPU. A job for "cuda" runs on whichever GPU
+// of `gpus` is free, pinned to it with CUDA_VISIBLE_DEVICES (so it sees that
+// GPU alone, as its device 0); with no `gpus` such jobs run one at a time,
+// unpinned. A job for "cuda:N" runs on device N, unpinned, when no other job
+// holds N. Children die with the
 // orchestrator (PR_SET_PDEATHSIG), even when it is killed with SIGKILL, so no
 // orphan keeps writing into a workspace that a new run is cleaning up.
 //
@@ -10,6 +14,10 @@
 #include <chrono>
 #include <deque>
 #include <map>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
 #include <sys/types.h>
 
 #include "tega/pipeline/executor.h"
@@ -18,7 +26,9 @@ namespace tega::pipeline {
 
 class LocalExecutor : public Executor {
  public:
-  explicit LocalExecutor(int cpu_slots, std::chrono::milliseconds stop_grace = std::chrono::seconds(5));
+  // `gpus`: CUDA_VISIBLE_DEVICES entries (gpus.h), e.g. machine_gpus().
+  explicit LocalExecutor(int cpu_slots, std::vector<std::string> gpus = {},
+                         std::chrono::milliseconds stop_grace = std::chrono::seconds(5));
   ~LocalExecutor() override;  // cancel_all()
 
   void submit(Job job) override;
@@ -31,14 +41,20 @@ class LocalExecutor : public Executor {
  private:
   struct Running {
     Job job;
+    std::string gpu;     // the GPU it holds (a `gpus` entry, "N" of "cuda:N", or "cuda"); "" for a CPU job
+    bool pinned = false;  // started with CUDA_VISIBLE_DEVICES=gpu
     std::chrono::steady_clock::time_point started;
   };
 
   void start_ready_jobs(std::vector<JobResult>& results);
-  pid_t launch(const Job& job);  // throws tega::Error when the log cannot be opened or fork fails
+  // The GPU `job` can start on now and whether it is pinned to it; nullopt while it must wait.
+  std::optional<std::pair<std::string, bool>> free_gpu(const Job& job) const;
+  // Throws tega::Error when the log cannot be opened or fork fails.
+  pid_t launch(const Job& job, const std::string& pinned_gpu);
   bool reap(std::vector<JobResult>& results, bool block);
 
   int cpu_slots_;
+  std::vector<std::string> gpus_;
   std::chrono::milliseconds stop_grace_;
   std::deque<Job> queue_;
   std::map<pid_t, Running> running_;
