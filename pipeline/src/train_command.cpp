@@ -5,6 +5,7 @@
 #include "commands.h"
 #include "stage_options.h"
 #include "tega/core/error.h"
+#include "tega/core/log.h"
 #include "tega/core/options.h"
 #include "tega/trainer/trainer.h"
 
@@ -29,7 +30,9 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--data", args->data, "Dataset directory (docs/layouts.md#dataset).");
   cmd->add_option("--out", args->out, "Run directory: checkpoint, metrics, options (docs/layouts.md#run).");
   cmd->add_option("--iterations", args->iterations, "Training iterations (default 60000; schedules scale with it).");
-  cmd->add_option("--device", args->device, "cpu or cuda (default cpu).");
+  cmd->add_option("--device", args->device,
+                  "cpu or cuda (default cpu; on the CPU without --config the defaults are CPU-sized: "
+                  "docs/training.md#on-the-cpu).");
   args->options.add_to(*cmd, "", "training", "densify.max_gaussians=1000000");
   cmd->add_option("--ablation", args->ablations,
                   "Paper Table 1 ablation: no-warp, no-shading, no-network, no-densify, ga-binding, mlp-only, cap-200k "
@@ -44,18 +47,34 @@ void add_train_command(CLI::App& app) {
   cmd->add_flag("--force", args->force, "Start over even if --out already holds a run.");
   cmd->add_flag("--profile", args->profile, "Report the time of each part of a step (slower).");
   cmd->callback([args] {
-    trainer::TrainOptions options;
-    if (args->resume) {
-      load_options(options, std::filesystem::path(args->out) / "options.yaml");
-    } else if (!args->options.config.empty()) {
-      load_options(options, args->options.config);
+    // Everything the user gave, over `base`.
+    const auto assembled = [&](trainer::TrainOptions options) {
+      if (args->resume) {
+        load_options(options, std::filesystem::path(args->out) / "options.yaml");
+      } else if (!args->options.config.empty()) {
+        load_options(options, args->options.config);
+      }
+      if (!args->baseline.empty()) trainer::apply_baseline(options, args->baseline);
+      for (const auto& ablation : args->ablations) trainer::apply_ablation(options, ablation);
+      apply_overrides(options, args->options.overrides);
+      if (args->iterations) options.iterations = *args->iterations;
+      if (args->device) options.device = *args->device;
+      if (args->profile) options.profile = true;
+      return options;
+    };
+    trainer::TrainOptions options = assembled({});
+    const bool configured = args->resume || !args->options.config.empty();
+    if (!configured && options.device == "cpu") {
+      options = assembled(trainer::cpu_sized_options());
+      logging::info("tega train: on the CPU with no config: CPU-sized defaults (%lld iterations, at most %lld "
+                    "Gaussians, a %d² U-Net; docs/training.md#on-the-cpu)",
+                    static_cast<long long>(options.iterations), static_cast<long long>(options.densify.max_gaussians),
+                    options.network.texture_size);
+    } else if (const std::string heavy = trainer::gpu_sized_on_cpu(options); !heavy.empty()) {
+      logging::warn("tega train: on the CPU with options sized for a GPU (%s): expect a fraction of an iteration a "
+                    "second; docs/training.md#on-the-cpu has CPU sizes",
+                    heavy.c_str());
     }
-    if (!args->baseline.empty()) trainer::apply_baseline(options, args->baseline);
-    for (const auto& ablation : args->ablations) trainer::apply_ablation(options, ablation);
-    apply_overrides(options, args->options.overrides);
-    if (args->iterations) options.iterations = *args->iterations;
-    if (args->device) options.device = *args->device;
-    if (args->profile) options.profile = true;
     if (args->options.print_if_asked(options)) return;
     if (args->data.empty() || args->out.empty()) throw Error("tega train needs --data and --out");
     const auto s = trainer::train(args->data, args->out, options, {args->resume, args->force, args->stop_at});

@@ -81,6 +81,34 @@ TEST(CliSynth, SetOverridesTheConfigAndAnUnknownKeyIsNamed) {
   EXPECT_NE(malformed.output.find("--set frames: expected key=value"), std::string::npos) << malformed.output;
 }
 
+// On the CPU without a config, `tega train` starts from CPU sizes; on a GPU, or with a config,
+// from the options' own, and a config that keeps GPU sizes on the CPU is warned of.
+TEST(CliTrain, TheCpuWithoutAConfigGetsCpuSizes) {
+  const auto cpu = run_tega("train --print-options");
+  if (cpu.output.find("could not be matched") != std::string::npos) GTEST_SKIP() << "this build has no tega train";
+  ASSERT_EQ(cpu.exit_code, 0) << cpu.output;
+  EXPECT_NE(cpu.output.find("\niterations: 3000\n"), std::string::npos) << cpu.output;
+  EXPECT_NE(cpu.output.find("\ninitial_gaussians: 4000\n"), std::string::npos) << cpu.output;
+  EXPECT_NE(cpu.output.find("  texture_size: 32\n"), std::string::npos) << cpu.output;
+  EXPECT_NE(cpu.output.find("CPU-sized defaults"), std::string::npos) << cpu.output;
+  const auto set = run_tega("train --device cpu --set iterations=50 --set network.texture_size=64 --print-options");
+  EXPECT_NE(set.output.find("\niterations: 50\n"), std::string::npos) << set.output;
+  EXPECT_NE(set.output.find("  texture_size: 64\n"), std::string::npos) << set.output;
+  EXPECT_NE(set.output.find("  max_gaussians: 15000\n"), std::string::npos) << set.output;
+
+  const auto gpu = run_tega("train --device cuda --print-options");
+  EXPECT_NE(gpu.output.find("\niterations: 60000\n"), std::string::npos) << gpu.output;
+  EXPECT_NE(gpu.output.find("\ninitial_gaussians: 500000\n"), std::string::npos) << gpu.output;
+
+  tega::test::TempDir tmp;
+  tega::test::write_text(tmp / "train.yaml", "device: cpu\niterations: 10\n");
+  const auto configured = run_tega("train --config " + (tmp / "train.yaml").string() + " --print-options");
+  EXPECT_NE(configured.output.find("\ninitial_gaussians: 500000\n"), std::string::npos) << configured.output;
+  EXPECT_NE(configured.output.find("sized for a GPU (initial_gaussians 500000, network.texture_size 256)"),
+            std::string::npos)
+      << configured.output;
+}
+
 TEST(CliRigConvert, KrtToJsonToColmapInMetres) {
   tega::test::TempDir tmp;
   tega::test::write_text(tmp / "KRT",

@@ -103,4 +103,32 @@ void validate_train_options(const TrainOptions& options) {
   }
 }
 
+TrainOptions cpu_sized_options() {
+  TrainOptions options;
+  options.device = "cpu";
+  options.iterations = 3000;
+  options.initial_gaussians = 4000;
+  options.densify.max_gaussians = 15000;
+  options.densify.interval = 0.01;               // every 30 iterations of 3000
+  options.densify.opacity_reset_interval = 1.0;  // none: too few iterations to grow back from one
+  options.loss.smoothness_samples = 500;
+  options.network.texture_size = 32;
+  options.network.unet_widths = {8, 16, 32};
+  options.network.latent_channels = 8;
+  options.network.mlp_hidden = 32;
+  options.uv_lookup.resolution = 256;
+  return options;
+}
+
+std::string gpu_sized_on_cpu(const TrainOptions& options) {
+  if (options.device != "cpu") return "";
+  const TrainOptions gpu_sized;
+  std::vector<std::string> parts;
+  if (options.initial_gaussians >= gpu_sized.initial_gaussians / 5)
+    parts.push_back("initial_gaussians " + std::to_string(options.initial_gaussians));
+  if (options.network.texture_size >= gpu_sized.network.texture_size / 2)
+    parts.push_back("network.texture_size " + std::to_string(options.network.texture_size));
+  return joined(parts);
+}
+
 }  // namespace tega::trainer

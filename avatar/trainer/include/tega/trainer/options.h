@@ -193,4 +193,14 @@ const std::vector<std::string>& baseline_names();
 // the trainer cannot run (an unknown binding, networks with rigged Gaussians).
 void validate_train_options(const TrainOptions& options);
 
+// The defaults for training on the CPU. TrainOptions' own are sized for a GPU (500K Gaussians
+// growing to 4M, a 256² U-Net, 60K iterations), which the CPU runs at 0.1-0.3 iterations a
+// second; these are the demo's sizes (studio_configs/demo.yaml) with 3000 iterations: 15K
+// Gaussians at most, a 32² U-Net of widths 8-32, a 256² uv lookup. `tega train` starts from them
+// on the CPU when it is given no config (docs/training.md#on-the-cpu).
+TrainOptions cpu_sized_options();
+
+// What of `options` is sized for a GPU though they run on the CPU ("" when nothing is), to warn of.
+std::string gpu_sized_on_cpu(const TrainOptions& options);
+
 }  // namespace tega::trainer
