@@ -55,6 +55,15 @@ TEST(PipelineConfig, NamesTheGpusOfALocalRunOrLeavesThemToTheMachine) {
             std::string::npos);
 }
 
+TEST(PipelineConfig, AStageMaySplitItsShardsIntoJobsOfSomeFrames) {
+  const auto c = parse("workspace: ws\nstages:\n  mvs: {frames_per_job: 25}\n  matte:\n");
+  EXPECT_EQ(c.stages[0].frames_per_job, 25);
+  EXPECT_EQ(c.stages[1].frames_per_job, 0);
+  EXPECT_NE(error_of([] { parse("workspace: ws\nstages:\n  mvs: {frames_per_job: -3}\n"); })
+                .find("stages.mvs.frames_per_job must be a whole number of frames"),
+            std::string::npos);
+}
+
 TEST(PipelineConfig, OptionsAreCanonicalWhateverTheirOrderAndLayout) {
   const auto a = parse("workspace: ws\nstages:\n  synth:\n    options:\n      seed: 1\n      studio: {width: 64, cameras: 2}\n");
   const auto b = parse("workspace: ws\nstages:\n  synth: {options: {studio: {cameras: 2, width: 64}, seed: 1}}\n");
@@ -107,7 +116,7 @@ TEST(PipelineConfig, UnknownKeysAreErrorsNamingTheFileAndTheKnownKeys) {
             "/cfg/p.yaml: unknown key 'stage' (line 2); known keys: description, workspace, subjects, stages, gpus");
   EXPECT_EQ(error_of([] { parse("workspace: ws\nstages:\n  synth: {option: {}}\n"); }),
             "/cfg/p.yaml: unknown key 'stages.synth.option' (line 3); known keys of 'stages.synth': kind, after, "
-            "options, options_file");
+            "options, options_file, frames_per_job");
   EXPECT_NE(error_of([] { parse("workspace: ws\nsubjects: {a: {options: {trian: {}}}}\nstages: {train: }\n"); })
                 .find("'subjects.a.options.trian' names no stage"),
             std::string::npos);

@@ -328,6 +328,30 @@ TEST(TegaRun, MeshesEveryPerformanceFrameWithTheCalibratedRig) {
   ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
   const std::string log = read_text_file(dir / "ws/logs/mvs/default.log");
   EXPECT_NE(log.find("0 frame(s) meshed, 2 already done"), std::string::npos) << log;
+
+  // Split into a job per frame, run at once: the same meshes, byte for byte.
+  const fs::path meshes = dir / "ws/mvs/default/meshes/speech";
+  const std::string unsplit[] = {read_text_file(meshes / "000000.ply"), read_text_file(meshes / "000001.ply")};
+  write_text(dir / "split.yaml", read_text_file(dir / "studio.yaml") + "    frames_per_job: 1\n");
+  const auto split = run_tega({"run", (dir / "split.yaml").string(), "--force", "mvs", "--jobs", "2"}, dir.path());
+  ASSERT_EQ(split.exit_code, 0) << split.output;
+  EXPECT_NE(split.output.find("mvs/default started as 2 jobs"), std::string::npos) << split.output;
+  EXPECT_TRUE(read_text_file(meshes / "000000.ply") == unsplit[0]);
+  EXPECT_TRUE(read_text_file(meshes / "000001.ply") == unsplit[1]);
+  for (const char* part : {"default#1.log", "default#2.log"}) {
+    const std::string part_log = read_text_file(dir / "ws/logs/mvs" / part);
+    EXPECT_NE(part_log.find("1 frame(s) meshed"), std::string::npos) << part << ": " << part_log;
+  }
+}
+
+TEST(TegaRun, OnlyStagesThatSplitTakeFramesPerJob) {
+  TempDir dir;
+  write_text(dir / "p.yaml", "workspace: ws\nstages:\n  synth:\n  check: {kind: dataset_check, after: synth, "
+                             "frames_per_job: 10}\n");
+  const auto r = run_tega({"run", (dir / "p.yaml").string()}, dir.path());
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("stage 'check': frames_per_job: a dataset_check shard runs as one job"), std::string::npos)
+      << r.output;
 }
 
 TEST(TegaRun, ABadGpuListIsAnErrorBeforeAnythingRuns) {

@@ -135,8 +135,14 @@ StageConfig read_stage(const Reader& r, const std::string& name, const YAML::Nod
   stage.kind = name;
   if (node.IsNull()) return stage;
   r.require_map(node, where);
-  r.check_keys(node, where, {"kind", "after", "options", "options_file"});
+  r.check_keys(node, where, {"kind", "after", "options", "options_file", "frames_per_job"});
   if (node["kind"]) stage.kind = r.scalar(node["kind"], where + ".kind");
+  if (node["frames_per_job"]) {
+    const std::string text = r.scalar(node["frames_per_job"], where + ".frames_per_job");
+    if (text.empty() || text.size() > 9 || text.find_first_not_of("0123456789") != std::string::npos)
+      r.fail(node["frames_per_job"], where + ".frames_per_job must be a whole number of frames, 0 for one job");
+    stage.frames_per_job = std::stoi(text);
+  }
   if (node["after"]) stage.after = r.string_list(node["after"], where + ".after");
   YAML::Node options;
   if (node["options_file"]) {

@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 #include <algorithm>
+#include <map>
 #include <optional>
 
 #include "tega/core/error.h"
@@ -29,6 +30,11 @@ struct ShardRun {
   std::vector<std::string> command;
   std::string started;
   std::string output_hash;  // once done
+  // Its jobs, by id: one, or one per part of a split shard (StageKind::split).
+  std::map<std::string, Job> jobs;
+  size_t jobs_running = 0;
+  double seconds = 0;        // its longest job's
+  std::string job_failure;   // the first failed job's error, reported when the last has finished
 };
 
 class Run {
@@ -205,46 +211,85 @@ class Run {
       const auto device = scalar_option(s.fingerprint.options_yaml, stage.kind->device_option);
       if (device && device->rfind("cuda", 0) == 0) job.resources.gpu_device = *device;
     }
-
     s.command = job.argv;
+
+    std::vector<std::vector<std::string>> parts;
+    if (stage.config->frames_per_job > 0) parts = stage.kind->split(paths, stage.config->frames_per_job);
+    s.jobs.clear();
+    if (parts.size() > 1) {
+      // Each part its own job id and log ("mvs/alice#2", logs/mvs/alice#2.log): '#' is in no
+      // subject's name.
+      for (size_t k = 0; k < parts.size(); ++k) {
+        Job part = job;
+        part.id = s.id + "#" + std::to_string(k + 1);
+        part.argv.insert(part.argv.end(), parts[k].begin(), parts[k].end());
+        part.log_file = ws_.log_file(stage.name(), subject.name + "#" + std::to_string(k + 1));
+        s.jobs.emplace(part.id, std::move(part));
+      }
+    } else {
+      s.jobs.emplace(job.id, std::move(job));
+    }
+
     s.started = utc_now();
-    write_shard_state(ws_.state_file(stage.name(), subject.name),
-                      {"running", "", job.log_file.string(), s.started, ""});
-    spdlog::info("{} started{} (log: {})", s.id, job.resources.gpu_device.empty() ? "" : " on " + job.resources.gpu_device,
-                 job.log_file.string());
+    s.seconds = 0;
+    s.job_failure.clear();
+    s.jobs_running = s.jobs.size();
+    const Job& first = s.jobs.begin()->second;
+    write_shard_state(ws_.state_file(stage.name(), subject.name), {"running", "", first.log_file.string(), s.started, ""});
+    spdlog::info("{} started{}{} (log: {})", s.id,
+                 s.jobs.size() > 1 ? " as " + std::to_string(s.jobs.size()) + " jobs" : "",
+                 first.resources.gpu_device.empty() ? "" : " on " + first.resources.gpu_device,
+                 s.jobs.size() > 1 ? ws_.log_file(stage.name(), subject.name + "#*").string() : first.log_file.string());
     s.phase = Phase::queued;
-    executor_.submit(std::move(job));
+    for (const auto& [id, part] : s.jobs) {
+      job_shard_[id] = static_cast<size_t>(&s - shards_.data());
+      executor_.submit(part);
+    }
   }
 
   void finish(const JobResult& result) {
-    auto it = std::find_if(shards_.begin(), shards_.end(), [&](const ShardRun& s) { return s.id == result.id; });
-    if (it == shards_.end()) return;
-    ShardRun& s = *it;
-    const Stage& stage = stage_of(s);
-    const std::string& subject = subject_of(s);
-    const fs::path log = ws_.log_file(stage.name(), subject);
+    const auto found = job_shard_.find(result.id);
+    if (found == job_shard_.end()) return;
+    ShardRun& s = shards_[found->second];
+    const auto job = s.jobs.find(result.id);
+    if (job == s.jobs.end()) return;
+    const fs::path log = job->second.log_file;
     if (result.requeue) {
-      spdlog::warn("{}: {}", s.id, result.failure);
+      spdlog::warn("{}: {}", result.id, result.failure);
       try {
-        launch(s);
+        if (s.jobs.size() > 1) {
+          executor_.submit(job->second);  // the other parts' files stay in the staging directory
+        } else {
+          launch(s);
+        }
       } catch (const std::exception& e) {
         fail(s, std::string("could not be started again: ") + e.what());
       }
       return;
     }
-    if (!result.succeeded) {
-      fail(s, result.failure + ": " + last_error_line(log) + " (log: " + log.string() + ")");
+    --s.jobs_running;
+    s.seconds = std::max(s.seconds, result.seconds);
+    if (!result.succeeded && s.job_failure.empty()) {
+      s.job_failure = (s.jobs.size() > 1 ? result.id + ": " : "") + result.failure + ": " + last_error_line(log) +
+                      " (log: " + log.string() + ")";
+    }
+    if (s.jobs_running > 0) {
+      if (!result.succeeded) spdlog::error("{} failed; the shard fails when its other jobs end", result.id);
+      return;
+    }
+    if (!s.job_failure.empty()) {
+      fail(s, s.job_failure);
       return;
     }
     try {
-      commit(s, result.seconds);
+      commit(s, s.seconds);
     } catch (const std::exception& e) {
       fail(s, std::string("could not be committed: ") + e.what());
       return;
     }
     ++summary_.ran;
     settle(s, Phase::done, "");
-    spdlog::info("{} done in {}  [{}]", s.id, Progress::format_duration(result.seconds), progress_line(s.stage));
+    spdlog::info("{} done in {}  [{}]", s.id, Progress::format_duration(s.seconds), progress_line(s.stage));
   }
 
   void commit(ShardRun& s, double seconds) {
@@ -262,7 +307,7 @@ class Run {
     m.fingerprint = s.fingerprint;
     m.key = s.fingerprint.key();
     m.command = s.command;
-    m.log = ws_.log_file(stage.name(), subject).string();
+    m.log = s.jobs.begin()->second.log_file.string();  // a split shard's first part's
     m.started = s.started;
     m.finished = utc_now();
     m.seconds = seconds;
@@ -277,8 +322,8 @@ class Run {
   void fail(ShardRun& s, const std::string& error) {
     const Stage& stage = stage_of(s);
     const std::string& subject = subject_of(s);
-    write_shard_state(ws_.state_file(stage.name(), subject),
-                      {"failed", error, ws_.log_file(stage.name(), subject).string(), s.started, utc_now()});
+    const fs::path log = s.jobs.empty() ? ws_.log_file(stage.name(), subject) : s.jobs.begin()->second.log_file;
+    write_shard_state(ws_.state_file(stage.name(), subject), {"failed", error, log.string(), s.started, utc_now()});
     ++summary_.failed;
     summary_.problems.push_back(s.id + " failed: " + error);
     settle(s, Phase::failed, error);
@@ -344,6 +389,7 @@ class Run {
   Workspace ws_;
   std::vector<bool> selected_, forced_, evaluated_;
   std::vector<ShardRun> shards_;
+  std::map<std::string, size_t> job_shard_;  // job id -> its shard's index in shards_
   int settled_ = 0, to_settle_ = 0;
   Clock::time_point started_ = Clock::now();
   RunSummary summary_;

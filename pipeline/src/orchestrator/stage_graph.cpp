@@ -58,6 +58,10 @@ StageGraph::StageGraph(PipelineConfig config, const CommandAvailable& available)
       throw Error(source, "stage '" + sc.name + "': unknown kind '" + sc.kind + "'; known kinds: " + known_kinds());
     }
     check_options(config_, sc, *stage.kind);
+    if (sc.frames_per_job > 0 && !stage.kind->split) {
+      throw Error(source, "stage '" + sc.name + "': frames_per_job: a " + stage.kind->name +
+                              " shard runs as one job (only mvs and matte split into jobs)");
+    }
     for (const auto& up : sc.after) {
       const auto it = by_name.find(up);
       if (it == by_name.end()) throw Error(source, "stage '" + sc.name + "': 'after' names no stage: '" + up + "'");

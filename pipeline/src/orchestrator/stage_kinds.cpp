@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "tega/core/take.h"
+
 namespace tega::pipeline {
 namespace {
 
@@ -15,6 +17,33 @@ std::vector<std::string> with_config(std::vector<std::string> arguments, const S
 std::vector<std::string> with_flags(std::vector<std::string> arguments, const ShardPaths& p) {
   arguments.insert(arguments.end(), p.option_flags.begin(), p.option_flags.end());
   return arguments;
+}
+
+// The capture's performance takes, as `tega mvs` and `tega matte` take them by default.
+std::vector<CaptureTake> performance_takes(const ShardPaths& p) {
+  std::vector<CaptureTake> takes;
+  for (const CaptureTake& take : read_capture(p.artifacts.at("capture")).takes)
+    if (take.kind == "performance") takes.push_back(take);
+  return takes;
+}
+
+// A job per take and run of at most `frames_per_job` frames.
+std::vector<std::vector<std::string>> by_frame_ranges(const ShardPaths& p, int frames_per_job) {
+  std::vector<std::vector<std::string>> jobs;
+  for (const CaptureTake& take : performance_takes(p)) {
+    for (int first = 0; first < take.frames; first += frames_per_job) {
+      const int end = std::min(take.frames, first + frames_per_job);
+      jobs.push_back({"--take", take.name, "--frames", std::to_string(first) + ":" + std::to_string(end)});
+    }
+  }
+  return jobs;
+}
+
+// A job per take: each writes its take's own summary file.
+std::vector<std::vector<std::string>> by_takes(const ShardPaths& p, int) {
+  std::vector<std::vector<std::string>> jobs;
+  for (const CaptureTake& take : performance_takes(p)) jobs.push_back({"--take", take.name});
+  return jobs;
 }
 
 std::vector<StageKind> make_stage_kinds() {
@@ -200,6 +229,7 @@ std::vector<StageKind> make_stage_kinds() {
                         "--out", (p.output / "meshes").string()},
                        p);
   };
+  mvs.split = by_frame_ranges;
   kinds.push_back(mvs);
   // Every performance take, its frames in order; the model is an option (a path).
   StageKind track;
@@ -232,6 +262,7 @@ std::vector<StageKind> make_stage_kinds() {
                         "--tracked", p.artifacts.at("tracked").string(), "--out", (p.output / "mattes").string()},
                        p);
   };
+  matte.split = by_takes;
   kinds.push_back(matte);
   // The trainer's dataset: sampled frames, undistorted and downsampled RGBA
   // images, matted by a matte stage upstream or, without one, here (the

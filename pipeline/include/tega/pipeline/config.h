@@ -17,6 +17,9 @@ struct StageConfig {
   std::string name;                // the key under `stages`
   std::string kind;                // `kind`, default: the name (docs/pipeline.md#stage-kinds)
   std::vector<std::string> after;  // upstream stages
+  // `frames_per_job: N`: each shard runs as several jobs at once, each on at most N frames of
+  // one take (kinds with StageKind::split only); 0: one job a shard.
+  int frames_per_job = 0;
   // `options_file` (a file in the command's own --config format) with
   // `options` merged over it; canonical YAML, "" = none.
   std::string options_yaml;

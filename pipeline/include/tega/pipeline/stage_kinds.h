@@ -49,6 +49,11 @@ struct StageKind {
   // the same fingerprint keeps its staging directory instead of starting over.
   bool resumes_in_staging = false;
   std::function<std::vector<std::string>(const ShardPaths&)> arguments;  // after the subcommand
+  // How a shard splits into jobs that run at once (the stage's `frames_per_job`): each job's
+  // arguments after `arguments`' (e.g. --take T --frames A:B). The jobs write disjoint files
+  // into the one staging directory, which is committed when all of them have succeeded. Empty:
+  // the kind does not split (tracking fits a take's frames in order).
+  std::function<std::vector<std::vector<std::string>>(const ShardPaths&, int frames_per_job)> split;
 };
 
 const std::vector<StageKind>& stage_kinds();
