@@ -16,6 +16,8 @@ tega_require(yaml-cpp libyaml-cpp-dev)
 tega_require(spdlog libspdlog-dev)
 tega_require(CLI11 libcli11-dev)
 tega_require(PNG libpng-dev)
+# gzip streams of SPZ splat files (tega export --format spz).
+tega_require(ZLIB zlib1g-dev)
 # SHA-256 of the orchestrator's manifests (libcrypto's EVP interface).
 tega_require(OpenSSL libssl-dev)
 # OpenMesh: core's mesh tools (decimation, smoothing, adjacency,

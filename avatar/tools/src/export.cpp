@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "tega/core/error.h"
+#include "tega/tools/gaussian_spz.h"
 #include "tega/trainer/spherical_harmonics.h"
 
 namespace tega::tools {
@@ -59,6 +61,24 @@ GaussianCloud export_frame(trainer::AvatarModel& model, const trainer::FrameInpu
   cloud.log_scale = shape.log_scale.to(at::kFloat);
   cloud.rotation = shape.rotation.to(at::kFloat);
   return cloud;
+}
+
+ExportFormat export_format(const std::string& requested, const std::filesystem::path& out) {
+  const std::string extension = out.extension().string();
+  const bool named_by_extension = extension == ".ply" || extension == ".spz";
+  if (requested.empty()) return extension == ".spz" ? ExportFormat::spz : ExportFormat::ply;
+  if (requested != "ply" && requested != "spz") throw Error("tega export: --format " + requested + ": use ply or spz");
+  if (named_by_extension && extension != "." + requested)
+    throw Error(out, "names a " + extension.substr(1) + " file, but --format is " + requested);
+  return requested == "spz" ? ExportFormat::spz : ExportFormat::ply;
+}
+
+std::string file_extension(ExportFormat format) { return format == ExportFormat::spz ? ".spz" : ".ply"; }
+
+void write_gaussians(const GaussianCloud& cloud, const std::filesystem::path& file, ExportFormat format,
+                     bool antialiased) {
+  if (format == ExportFormat::spz) write_gaussian_spz(cloud, file, antialiased);
+  else write_gaussian_ply(cloud, file);
 }
 
 }  // namespace tega::tools

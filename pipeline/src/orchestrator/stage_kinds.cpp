@@ -156,12 +156,12 @@ std::vector<StageKind> make_stage_kinds() {
   // frame of a studio subject would be gigabytes of Gaussians each.
   StageKind export_ply;
   export_ply.name = "export";
-  export_ply.summary = "exports posed Gaussians as 3D Gaussian Splatting PLY files (tega export)";
+  export_ply.summary = "exports posed Gaussians as 3D Gaussian Splatting PLY or SPZ files (tega export)";
   export_ply.subcommand = {"export"};
   export_ply.needs = {"run", "dataset"};
   export_ply.provides = {{"export", "export"}};
   export_ply.options_as = OptionsAs::flags;
-  export_ply.flag_options = {"frame", "meshes", "mesh_pose", "head_space", "device"};
+  export_ply.flag_options = {"frame", "meshes", "mesh_pose", "head_space", "format", "device"};
   export_ply.path_options = {"meshes"};
   export_ply.device_option = "device";
   export_ply.arguments = [](const ShardPaths& p) {

@@ -11,6 +11,7 @@
 #include "tega/core/files.h"
 #include "tega/tools/export.h"
 #include "tega/tools/gaussian_ply.h"
+#include "tega/tools/gaussian_spz.h"
 #include "tega/trainer/render.h"
 #include "tega/trainer/spherical_harmonics.h"
 #include "test_support.h"
@@ -210,6 +211,28 @@ TEST(Export, DecompositionRebuildsCovariances) {
   EXPECT_TRUE(sr.rotation.select(1, 0).ge(0).all().item<bool>());
   const at::Tensor rebuilt = splat::covariance_from_scale_rotation(sr.log_scale.exp(), sr.rotation);
   EXPECT_TRUE(at::allclose(rebuilt, packed, 1e-9, 1e-9));
+}
+
+TEST(Export, FormatIsTheFlagsElseTheExtensionsElsePly) {
+  EXPECT_EQ(export_format("", "avatar.spz"), ExportFormat::spz);
+  EXPECT_EQ(export_format("", "avatar.ply"), ExportFormat::ply);
+  EXPECT_EQ(export_format("", "frames"), ExportFormat::ply);
+  EXPECT_EQ(export_format("spz", "frames"), ExportFormat::spz);
+  EXPECT_EQ(export_format("spz", "frames.v2"), ExportFormat::spz);  // a directory with a dot
+  EXPECT_EQ(export_format("ply", "avatar.ply"), ExportFormat::ply);
+  EXPECT_EQ(file_extension(ExportFormat::spz), ".spz");
+  const std::string message = test::error_message([] { export_format("spz", "avatar.ply"); });
+  EXPECT_NE(message.find("avatar.ply"), std::string::npos) << message;
+  EXPECT_NE(message.find("--format is spz"), std::string::npos) << message;
+
+  // write_gaussians writes the format it is given.
+  test::TempDir tmp;
+  const GaussianCloud cloud{at::zeros({2, 3}), at::zeros({2, 1, 3}), at::zeros({2}), at::zeros({2, 3}),
+                            at::tensor({1.f, 0.f, 0.f, 0.f}).repeat({2, 1})};
+  write_gaussians(cloud, tmp / "a.spz", ExportFormat::spz, true);
+  EXPECT_TRUE(read_gaussian_spz(tmp / "a.spz").antialiased);
+  write_gaussians(cloud, tmp / "a.ply", ExportFormat::ply, true);
+  EXPECT_EQ(read_gaussian_ply(tmp / "a.ply").size(), 2);
 }
 
 TEST(GaussianPly, ReadsAsciiAnyOrderAndNamesWhatIsMissing) {

@@ -9,6 +9,7 @@
 
 #include <string>
 
+#include "tega/core/error.h"
 #include "tega/core/log.h"
 #include "tega/core/options.h"
 #include "tega/nn/module_io.h"

@@ -1,7 +1,7 @@
 #pragma once
 // `tega export`: one frame of a trained avatar as world-space Gaussians in
-// 3DGS's layout (gaussian_ply.h), so that standard splat viewers show what
-// render_view() renders.
+// 3DGS's layout (gaussian_ply.h) or in SPZ (gaussian_spz.h), so that standard
+// splat viewers show what render_view() renders.
 //
 // Two things of TeGA have no place in a 3DGS file and are baked:
 //  - the covariance J Σ_uvd Jᵀ is decomposed into scale and rotation
@@ -14,6 +14,9 @@
 // degree-3 viewer sees the degree the avatar was trained with.
 
 #include <ATen/ATen.h>
+
+#include <filesystem>
+#include <string>
 
 #include "tega/tools/gaussian_ply.h"
 #include "tega/trainer/avatar_model.h"
@@ -32,5 +35,16 @@ struct ScaleRotation {
   at::Tensor log_scale, rotation;
 };
 ScaleRotation decompose_covariances(const at::Tensor& covariances, double min_variance = 1e-24);
+
+enum class ExportFormat { ply, spz };
+
+// The format `requested` names ("ply" or "spz"); where it is empty, the one
+// `out`'s extension names, else PLY. Throws tega::Error when the two disagree.
+ExportFormat export_format(const std::string& requested, const std::filesystem::path& out);
+std::string file_extension(ExportFormat format);  // ".ply", ".spz"
+
+// write_gaussian_ply or write_gaussian_spz; only SPZ records `antialiased`.
+void write_gaussians(const GaussianCloud& cloud, const std::filesystem::path& file, ExportFormat format,
+                     bool antialiased);
 
 }  // namespace tega::tools
