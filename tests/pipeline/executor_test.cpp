@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <optional>
 
@@ -144,6 +145,20 @@ TEST(LocalExecutor, AJobForOneDeviceWaitsForThePinnedJobOnItAndRunsUnpinned) {
   ASSERT_EQ(results.size(), 3u);
   for (const auto& r : results) EXPECT_TRUE(r.succeeded) << r.id << ": " << r.failure;
   EXPECT_EQ(gpu_seen(dir, "given"), "0,1");  // cuda:1 names the machine's device 1: not pinned
+}
+
+TEST(LocalExecutor, ReportsEachJobsPeakResidentMemory) {
+  test::TempDir dir;
+  LocalExecutor executor(2);
+  executor.submit(shell_job("big", "python3 -c \"x = b'1' * (300 << 20)\"", dir));
+  executor.submit(shell_job("small", "true", dir));
+  auto results = wait_for_all(executor, 30s);
+  ASSERT_EQ(results.size(), 2u);
+  std::sort(results.begin(), results.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
+  ASSERT_TRUE(results[0].succeeded) << results[0].failure;
+  EXPECT_GT(results[0].peak_rss_kib, 300 << 10);  // "big": 300 MiB of bytes, touched
+  EXPECT_GT(results[1].peak_rss_kib, 0);
+  EXPECT_LT(results[1].peak_rss_kib, 50 << 10);
 }
 
 TEST(LocalExecutor, ReportsFailuresAndAppendsOutputToTheLog) {

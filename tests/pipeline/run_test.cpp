@@ -58,6 +58,9 @@ TEST(TegaRun, SkipsDoneShardsAndReRunsOnlyWhatAChangedOptionReaches) {
   auto r = run_tega({"run", (dir / "p.yaml").string(), "--jobs", "2"}, dir.path());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("4 shard(s) ran, 0 up to date"), std::string::npos) << r.output;
+  const json synth_manifest = json::parse(read_text_file(ws / "synth_a/default/manifest.json"));
+  EXPECT_GT(synth_manifest["peak_rss_mib"].get<double>(), 1.0);  // tega synth's own, from wait4
+  EXPECT_LT(synth_manifest["peak_rss_mib"].get<double>(), 4096.0);
 
   r = run_tega({"run", (dir / "p.yaml").string()}, dir.path());
   ASSERT_EQ(r.exit_code, 0) << r.output;

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -145,12 +146,15 @@ bool LocalExecutor::reap(std::vector<JobResult>& results, bool block) {
   bool any = false;
   for (auto it = running_.begin(); it != running_.end();) {
     int status = 0;
-    const pid_t done = ::waitpid(it->first, &status, block ? 0 : WNOHANG);
+    struct rusage usage {};
+    const pid_t done = ::wait4(it->first, &status, block ? 0 : WNOHANG, &usage);
     if (done == it->first || (done < 0 && errno == ECHILD)) {
       const double seconds = std::chrono::duration<double>(Clock::now() - it->second.started).count();
       const bool ok = done == it->first && WIFEXITED(status) && WEXITSTATUS(status) == 0;
-      results.push_back({it->second.job.id, ok, ok ? "" : done < 0 ? "lost track of the process" : describe_exit(status),
-                         seconds});
+      JobResult result{it->second.job.id, ok, ok ? "" : done < 0 ? "lost track of the process" : describe_exit(status),
+                       seconds};
+      if (done == it->first) result.peak_rss_kib = usage.ru_maxrss;  // Linux: kibibytes
+      results.push_back(std::move(result));
       it = running_.erase(it);
       any = true;
     } else {

@@ -51,6 +51,7 @@ void write_manifest(const fs::path& file, const Manifest& m) {
                   {"started", m.started},
                   {"finished", m.finished},
                   {"seconds", m.seconds},
+                  {"peak_rss_mib", m.peak_rss_mib},
                   {"output_hash", m.output_hash},
                   {"outputs", outputs}};
   write_text_atomic(file, j.dump(2) + "\n");
@@ -74,6 +75,7 @@ std::optional<Manifest> read_manifest(const fs::path& file) {
     m.started = j.at("started");
     m.finished = j.at("finished");
     m.seconds = j.at("seconds");
+    m.peak_rss_mib = j.value("peak_rss_mib", 0.0);  // absent from manifests written before it was recorded
     m.output_hash = j.at("output_hash");
     for (const auto& o : j.at("outputs")) m.outputs.push_back({o.at("path"), o.at("size"), o.at("sha256")});
     return m;

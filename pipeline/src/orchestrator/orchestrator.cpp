@@ -34,6 +34,7 @@ struct ShardRun {
   std::map<std::string, Job> jobs;
   size_t jobs_running = 0;
   double seconds = 0;        // its longest job's
+  long peak_rss_kib = 0;     // its largest job's
   std::string job_failure;   // the first failed job's error, reported when the last has finished
 };
 
@@ -232,6 +233,7 @@ class Run {
 
     s.started = utc_now();
     s.seconds = 0;
+    s.peak_rss_kib = 0;
     s.job_failure.clear();
     s.jobs_running = s.jobs.size();
     const Job& first = s.jobs.begin()->second;
@@ -269,6 +271,7 @@ class Run {
     }
     --s.jobs_running;
     s.seconds = std::max(s.seconds, result.seconds);
+    s.peak_rss_kib = std::max(s.peak_rss_kib, result.peak_rss_kib);
     if (!result.succeeded && s.job_failure.empty()) {
       s.job_failure = (s.jobs.size() > 1 ? result.id + ": " : "") + result.failure + ": " + last_error_line(log) +
                       " (log: " + log.string() + ")";
@@ -311,6 +314,7 @@ class Run {
     m.started = s.started;
     m.finished = utc_now();
     m.seconds = seconds;
+    m.peak_rss_mib = s.peak_rss_kib / 1024.0;
     m.outputs = hash_outputs(staging);
     m.output_hash = outputs_hash(m.outputs);
     write_manifest(staging / kManifestFile, m);

@@ -36,6 +36,9 @@ struct JobResult {
   // its command, and may be tried again: the orchestrator prepares its shard afresh (a killed
   // attempt leaves a partial staging directory) and submits it again under the same id.
   bool requeue = false;
+  // The largest resident memory of the job's process (or, of its children, the largest one's),
+  // kibibytes; 0 where the executor cannot tell (Slurm).
+  long peak_rss_kib = 0;
 };
 
 class Executor {

@@ -33,6 +33,7 @@ struct Manifest {
   std::string log;                   // the shard's log file
   std::string started, finished;     // UTC, ISO 8601
   double seconds = 0;
+  double peak_rss_mib = 0;           // the command's largest resident memory (a split shard's largest job's); 0: unknown
   std::vector<OutputFile> outputs;   // every file of the shard but the manifest, sorted
   std::string output_hash;           // hash of `outputs`: what downstream fingerprints see
 };
