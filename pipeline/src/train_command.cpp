@@ -1,12 +1,15 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <thread>
 
 #include "commands.h"
 #include "stage_options.h"
+#include "train_processes.h"
 #include "tega/core/error.h"
 #include "tega/core/log.h"
 #include "tega/core/options.h"
+#include "tega/pipeline/gpus.h"
 #include "tega/trainer/trainer.h"
 
 namespace tega::cli {
@@ -20,6 +23,8 @@ struct TrainArguments {
   int64_t stop_at = 0;
   std::optional<std::string> device;
   bool resume = false, force = false, profile = false;
+  std::optional<std::string> gpus;
+  int processes = 0;
   StageOptionFlags options;
 };
 }  // namespace
@@ -46,6 +51,11 @@ void add_train_command(CLI::App& app) {
                   "Stop with a checkpoint after this iteration; continue later with --resume.");
   cmd->add_flag("--force", args->force, "Start over even if --out already holds a run.");
   cmd->add_flag("--profile", args->profile, "Report the time of each part of a step (slower).");
+  cmd->add_option("--gpus", args->gpus,
+                  "Train on several GPUs at once, one process each (indices or UUIDs, e.g. 0,1,2,3): every GPU renders "
+                  "its own view of a step and the gradients are averaged (docs/training.md#on-several-gpus).");
+  cmd->add_option("--processes", args->processes,
+                  "Train in this many processes on the CPU, as --gpus does on GPUs (a step sees as many views).");
   cmd->callback([args] {
     // Everything the user gave, over `base`.
     const auto assembled = [&](trainer::TrainOptions options) {
@@ -77,7 +87,29 @@ void add_train_command(CLI::App& app) {
     }
     if (args->options.print_if_asked(options)) return;
     if (args->data.empty() || args->out.empty()) throw Error("tega train needs --data and --out");
-    const auto s = trainer::train(args->data, args->out, options, {args->resume, args->force, args->stop_at});
+    if (args->gpus || args->processes > 1) {
+      if (args->gpus && args->processes > 0) throw Error("tega train: --gpus or --processes, not both");
+      const std::vector<std::string> gpus = args->gpus ? pipeline::parse_gpu_list(*args->gpus, "--gpus")
+                                                       : std::vector<std::string>{};
+      if (args->gpus && options.device.rfind("cuda", 0) != 0)
+        throw Error("tega train: --gpus trains on GPUs: pass --device cuda (or --processes N for the CPU)");
+      if (!args->gpus && options.device != "cpu")
+        throw Error("tega train: --processes spreads CPU training; on GPUs pass --gpus");
+      const int world = args->gpus ? static_cast<int>(gpus.size()) : args->processes;
+      if (world > 1) {
+        const int status = run_training_processes(world, gpus, args->out);
+        if (status != 0) throw CLI::RuntimeError(status);
+        return;
+      }
+    }
+    trainer::RunControl control{args->resume, args->force, args->stop_at};
+    if (const auto rank = parallel_rank_from_environment()) {
+      control.parallel = *rank;
+      if (options.device == "cpu" && options.cpu_threads == 0)  // the cores shared out, not each taken by all
+        options.cpu_threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / rank->world);
+    }
+    const auto s = trainer::train(args->data, args->out, options, control);
+    if (control.parallel.rank > 0) return;
     if (s.interrupted) {
       std::cerr << "tega train: interrupted after " << s.iterations << " of " << options.iterations
                 << " iterations; checkpoint saved: " << s.checkpoint.string() << "\n(tega train --out " << args->out

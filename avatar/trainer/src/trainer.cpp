@@ -28,6 +28,7 @@
 #include "tega/splat/rasterize.h"
 #include "tega/trainer/avatar_model.h"
 #include "tega/trainer/checkpoint.h"
+#include "tega/trainer/data_parallel.h"
 #include "tega/trainer/densifier.h"
 #include "tega/trainer/render.h"
 #include "tega/trainer/schedules.h"
@@ -103,8 +104,10 @@ double exponential(double from, double to, double t) { return from * std::pow(to
 // One training run: the model, its optimizer and everything a checkpoint holds.
 class Run {
  public:
-  Run(const fs::path& dataset_dir, const fs::path& run_dir, const TrainOptions& options, const RunControl& control)
+  Run(const fs::path& dataset_dir, const fs::path& run_dir, const TrainOptions& options, const RunControl& control,
+      DataParallel& parallel)
       : options_(options),
+        parallel_(parallel),
         run_dir_(run_dir),
         poisoned_iterations_(control.poisoned_iterations.begin(), control.poisoned_iterations.end()),
         device_(options.device),
@@ -159,7 +162,9 @@ class Run {
 
   TrainSummary train(int64_t stop_at) {
     const int64_t last = stop_at > 0 ? std::min(stop_at, options_.iterations) : options_.iterations;
-    ViewLoader loader(dataset_, train_views_, static_cast<uint64_t>(options_.seed), options_.loader_threads,
+    // Each process its own views: the same order from another seed.
+    const uint64_t view_seed = static_cast<uint64_t>(options_.seed) + 1000003ull * static_cast<uint64_t>(parallel_.rank());
+    ViewLoader loader(dataset_, train_views_, view_seed, options_.loader_threads,
                       options_.prefetch, /*pin_memory=*/device_.is_cuda());
     loader.seek(iteration_);
     const auto start = std::chrono::steady_clock::now();
@@ -188,10 +193,11 @@ class Run {
       step(view, take);
       ++iteration_;
       if (iteration_ == first + 1) first_done = std::chrono::steady_clock::now();
-      const bool interrupted = InterruptGuard::requested();
+      // Together, or a process would wait for the others' gradients forever.
+      const bool interrupted = parallel_.alone() ? InterruptGuard::requested() : interrupt_agreed_;
       const bool log_due = iteration_ % options_.log_every == 0 || iteration_ == last || interrupted;
       const bool checkpoint_due = iteration_ % options_.checkpoint_every == 0 && iteration_ < last;
-      if (log_due || checkpoint_due) take(readout_.pop());
+      if (log_due || checkpoint_due) take(agreed(readout_.pop()));
       if (failed) {
         roll_back(*failed);
         failed.reset();
@@ -210,7 +216,8 @@ class Run {
         summary.final_loss = window_loss / window;
         summary.train_psnr = window_psnr / window;
         metrics_.push_back({iteration_, summary.final_loss, summary.train_psnr, model_.gaussians.size(), seconds});
-        logging::info("it %lld/%lld  loss %.5f  psnr %.2f  gaussians %lld  %.2f it/s  ETA %s",
+        if (parallel_.leads())
+          logging::info("it %lld/%lld  loss %.5f  psnr %.2f  gaussians %lld  %.2f it/s  ETA %s",
                       static_cast<long long>(iteration_), static_cast<long long>(options_.iterations),
                       summary.final_loss, summary.train_psnr, static_cast<long long>(model_.gaussians.size()), rate,
                       Progress::format_duration(static_cast<double>(options_.iterations - iteration_) / rate).c_str());
@@ -232,7 +239,8 @@ class Run {
     summary.gaussians = model_.gaussians.size();
     summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     // An interrupted run (a scheduler's time limit, say) has seconds left, not the held-out renders' time.
-    summary.heldout_psnr = summary.interrupted ? std::numeric_limits<double>::quiet_NaN() : heldout_psnr();
+    summary.heldout_psnr = summary.interrupted || !parallel_.leads() ? std::numeric_limits<double>::quiet_NaN() : heldout_psnr();
+    check_replicas_agree();
     summary.checkpoint = run_dir_ / kCheckpoint;
     if (profiler_.enabled()) {
       summary.milliseconds_per_step = profiler_.mean_milliseconds(iteration_ - first);
@@ -314,20 +322,34 @@ class Run {
     profiler_.section("backward");
     adam_.zero_grad();
     loss.backward();
+    if (!parallel_.alone()) {
+      RECORD_FUNCTION("tega::gradient_all_reduce", std::vector<c10::IValue>());
+      std::vector<at::Tensor> gradients;
+      for (const auto& g : adam_.groups())
+        if (g.parameter.grad().defined()) gradients.push_back(g.parameter.grad());
+      parallel_.average(gradients);
+    }
     // A NaN/Inf is reported one step late: the step that made it has updated
     // the parameters by then, but nothing is saved before its check (the loop
     // takes the last step's values before every save, and the checkpoint
     // writer refuses non-finite tensors).
-    take(readout_.pop());
+    take(agreed(readout_.pop()));
     readout_.push(loss, mse, all_finite(loss), posed.largest_deformation, iteration_ + 1, loaded.view);
 
     profiler_.section("optimizer");
     {
       RECORD_FUNCTION("tega::optimizer", std::vector<c10::IValue>());
       adam_.step();
-      clamp_world_size(model_.gaussians, posed.world_std_per_scale, options_.min_std, options_.max_std);
+      // A Gaussian's size in metres depends on the frame each process posed: bound it in their
+      // mean, the same in every process, or the replicas would drift apart.
+      at::Tensor world_std_per_scale = posed.world_std_per_scale;
+      if (!parallel_.alone()) {
+        world_std_per_scale = world_std_per_scale.detach().clone();
+        parallel_.average({world_std_per_scale});
+      }
+      clamp_world_size(model_.gaussians, world_std_per_scale, options_.min_std, options_.max_std);
       at::NoGradGuard no_grad;
-      const at::Tensor world_std = (model_.gaussians.log_scale.exp() * posed.world_std_per_scale).amax(1);
+      const at::Tensor world_std = (model_.gaussians.log_scale.exp() * world_std_per_scale).amax(1);
       max_world_std_ = at::max(max_world_std_, world_std);
     }
 
@@ -389,6 +411,37 @@ class Run {
   // A failed step rolls the run back to its last checkpoint and lowers every
   // learning rate, once; a second one stops training (nothing from a failed
   // step is ever saved: the loop checks each step before it saves).
+  // A step's values as every process sees them: the loss and MSE averaged over the processes, a
+  // failure in one a failure in all; and whether any was asked to stop. One host all-reduce a step.
+  std::optional<StepValues> agreed(std::optional<StepValues> values) {
+    if (parallel_.alone()) return values;
+    const bool bad = values && !failure(*values).empty();
+    const std::vector<double> sums = parallel_.host_sum({values ? values->loss : 0.0, values ? values->mse : 0.0,
+                                                         bad ? 1.0 : 0.0, InterruptGuard::requested() ? 1.0 : 0.0});
+    interrupt_agreed_ = sums[3] > 0;
+    if (!values) return values;
+    values->loss = sums[0] / parallel_.world();
+    values->mse = sums[1] / parallel_.world();
+    if (sums[2] > 0 && !bad) values->finite = false;
+    return values;
+  }
+
+  // The processes' parameters must be equal after the same averaged steps; a difference would
+  // mean that they trained apart (a step one of them skipped).
+  void check_replicas_agree() {
+    if (parallel_.alone()) return;
+    double checksum = 0;
+    for (const auto& g : adam_.groups()) checksum += g.parameter.detach().to(at::kDouble).abs().sum().item<double>();
+    const double mean = parallel_.host_sum({checksum})[0] / parallel_.world();
+    const bool differs = std::abs(checksum - mean) > 1e-9 * std::max(1.0, std::abs(mean));
+    const double differing = parallel_.host_sum({differs ? 1.0 : 0.0})[0];
+    if (differing > 0)
+      throw Error("data-parallel training: the " + std::to_string(parallel_.world()) +
+                  " processes ended with different parameters (checksums around " + std::to_string(mean) + ")");
+    if (parallel_.leads())
+      logging::info("%d processes trained one model: their parameters agree (checksum %.9g)", parallel_.world(), mean);
+  }
+
   void roll_back(const StepValues& values) {
     const std::string what = "iteration " + std::to_string(values.iteration) + ": " + failure(values) + " (camera " +
                              dataset_.rig.cameras[values.view.camera].name + ", frame " +
@@ -416,7 +469,7 @@ class Run {
   void update_learning_rates() {
     const double t = static_cast<double>(iteration_) / static_cast<double>(std::max<int64_t>(1, options_.iterations - 1));
     const auto& lr = options_.learning_rates;
-    const double s = learning_rate_scale_;
+    const double s = learning_rate_scale_ * learning_rate_factor(parallel_.world());
     adam_.group("uvd").learning_rate = s * exponential(lr.position, lr.position_final, t);
     adam_.group("log_scale").learning_rate = s * lr.scale;
     adam_.group("rotation").learning_rate = s * lr.rotation;
@@ -437,6 +490,7 @@ class Run {
       // 3DGS's threshold is on gradients w.r.t. normalised device coordinates;
       // the rasterizer reports them per pixel.
       const double pixels_per_ndc = 0.5 * std::max(camera.width, camera.height);
+      parallel_.sum({stats_.grad_norm_sum, stats_.visible_count});  // every process's views count
       DensifyStats stats{stats_.grad_norm_sum * pixels_per_ndc, stats_.visible_count, max_world_std_};
       const DensifyResult r = densify(model_.gaussians, adam_, stats, d, model_.lookup(), generator_);
       logging::debug("densify at %lld: cloned %lld, split %lld, pruned %lld -> %lld Gaussians",
@@ -488,11 +542,14 @@ class Run {
     c.metadata["options"] = options_to_yaml(options_);
     c.metadata[kTextureMetadataKey] = kTextureWithoutEyeballs;
     c.metadata[kUvLayoutMetadataKey] = kUvLayoutChartsApartPacked;
-    // Kept until this one is written whole: killed in between, the run
-    // resumes from it.
-    if (fs::exists(run_dir_ / kCheckpoint)) fs::rename(run_dir_ / kCheckpoint, run_dir_ / kPreviousCheckpoint);
-    write_checkpoint(run_dir_ / kCheckpoint, c);
-    write_metrics(run_dir_ / kMetrics, metrics_);
+    if (parallel_.leads()) {
+      // Kept until this one is written whole: killed in between, the run
+      // resumes from it.
+      if (fs::exists(run_dir_ / kCheckpoint)) fs::rename(run_dir_ / kCheckpoint, run_dir_ / kPreviousCheckpoint);
+      write_checkpoint(run_dir_ / kCheckpoint, c);
+      write_metrics(run_dir_ / kMetrics, metrics_);
+    }
+    parallel_.barrier();  // a roll-back reads it in every process
     saved_iteration_ = iteration_;
   }
 
@@ -558,6 +615,7 @@ class Run {
   }
 
   TrainOptions options_;
+  DataParallel& parallel_;
   fs::path run_dir_;
   at::Device device_;
   Dataset dataset_;
@@ -579,6 +637,7 @@ class Run {
   bool rolled_back_ = false;
   std::set<int64_t> poisoned_iterations_;
   StepReadout readout_;
+  bool interrupt_agreed_ = false;  // a process was asked to stop, as of the last agreed step
 };
 
 }  // namespace
@@ -586,24 +645,30 @@ class Run {
 TrainSummary train(const fs::path& dataset, const fs::path& run, TrainOptions options, const RunControl& control) {
   at::set_num_threads(options.cpu_threads > 0 ? options.cpu_threads
                                               : static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+  DataParallel parallel(control.parallel, at::Device(options.device));
   const bool has_checkpoint = fs::exists(run / kCheckpoint) || fs::exists(run / kPreviousCheckpoint);
   if (control.resume) {
     if (!has_checkpoint) throw Error(run, "has no checkpoint to resume from");
   } else if (has_checkpoint && !control.overwrite) {
     throw Error(run, "already holds a run (pass --resume to continue it, or --force to start over)");
-  } else {
-    // The run they belonged to is over (--force).
-    fs::remove(run / kCheckpoint);
-    fs::remove(run / kPreviousCheckpoint);
   }
-  fs::create_directories(run);
-  write_text_atomic(run / kOptions, options_to_yaml(options));
+  parallel.barrier();  // every process has looked before the first one clears
+  if (parallel.leads()) {
+    if (!control.resume) {
+      // The run they belonged to is over (--force).
+      fs::remove(run / kCheckpoint);
+      fs::remove(run / kPreviousCheckpoint);
+    }
+    fs::create_directories(run);
+    write_text_atomic(run / kOptions, options_to_yaml(options));
+  }
 
-  // The networks' initial weights come from libtorch's global generator.
+  // The networks' initial weights come from libtorch's global generator: the same in every process.
   at::manual_seed(static_cast<uint64_t>(options.seed));
   InterruptGuard interrupt;
-  Run training(dataset, run, options, control);
+  Run training(dataset, run, options, control, parallel);
   TrainSummary summary = training.train(control.stop_at);
+  if (!parallel.leads()) return summary;
 
   const nlohmann::json report = {{"dataset", fs::absolute(dataset).string()},
                                  {"iterations", summary.iterations},

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "tega/trainer/parallel_rank.h"
 #include "tega/trainer/options.h"
 
 namespace tega::trainer {
@@ -48,6 +49,9 @@ struct RunControl {
   // Fault injection, for tests: the loss of each of these iterations
   // (1-based) is made NaN the first time the run reaches it.
   std::vector<int64_t> poisoned_iterations;
+  // This process's place among the processes that train one run together (data_parallel.h);
+  // world 1: alone. `tega train --gpus` / `--processes` start them.
+  ParallelRank parallel;
 };
 
 // Validates the dataset before anything else (throws tega::Error naming the

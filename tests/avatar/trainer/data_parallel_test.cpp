@@ -1,0 +1,59 @@
+#include "tega/trainer/data_parallel.h"
+
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "tega/core/error.h"
+#include "test_support.h"
+
+namespace tega::trainer {
+namespace {
+
+// Two processes' worth of the group, as two threads of this one (Gloo over the loopback).
+TEST(DataParallel, AveragesAndSumsOverTheProcessesAndAgreesOnHostNumbers) {
+  test::TempDir dir;
+  constexpr int kWorld = 2;
+  at::Tensor gradient[kWorld], other[kWorld], counts[kWorld];
+  std::vector<double> host[kWorld];
+  std::vector<std::thread> processes;
+  for (int rank = 0; rank < kWorld; ++rank) {
+    processes.emplace_back([&, rank] {
+      DataParallel parallel({rank, kWorld, dir / "rendezvous"}, at::kCPU);
+      gradient[rank] = at::full({3, 4}, rank + 1.0f);  // 1 and 2: mean 1.5
+      other[rank] = at::arange(5, at::kFloat) * (rank == 0 ? 1 : 3);  // mean 2 i
+      counts[rank] = at::full({6}, rank == 0 ? 2.0f : 5.0f);
+      parallel.average({gradient[rank], other[rank]});
+      parallel.sum({counts[rank]});
+      host[rank] = parallel.host_sum({rank == 0 ? 0.25 : 0.5, 1.0});
+      parallel.barrier();
+    });
+  }
+  for (auto& p : processes) p.join();
+  for (int rank = 0; rank < kWorld; ++rank) {
+    EXPECT_TRUE(at::equal(gradient[rank], at::full({3, 4}, 1.5f))) << gradient[rank];
+    EXPECT_TRUE(at::allclose(other[rank], at::arange(5, at::kFloat) * 2)) << other[rank];
+    EXPECT_TRUE(at::equal(counts[rank], at::full({6}, 7.0f))) << counts[rank];
+    EXPECT_EQ(host[rank], (std::vector<double>{0.75, 2.0}));
+  }
+}
+
+TEST(DataParallel, AloneEverythingIsTheIdentity) {
+  DataParallel alone;
+  at::Tensor t = at::arange(4, at::kFloat);
+  alone.average({t});
+  alone.sum({t});
+  EXPECT_TRUE(at::equal(t, at::arange(4, at::kFloat)));
+  EXPECT_EQ(alone.host_sum({3.0}), std::vector<double>{3.0});
+  EXPECT_TRUE(alone.leads());
+  EXPECT_THROW(DataParallel({2, 2, "x"}, at::kCPU), Error);  // rank 2 of 0..1
+}
+
+TEST(DataParallel, LearningRatesGrowWithTheSquareRootOfTheViewsAStep) {
+  EXPECT_DOUBLE_EQ(learning_rate_factor(1), 1.0);
+  EXPECT_DOUBLE_EQ(learning_rate_factor(4), 2.0);
+  EXPECT_DOUBLE_EQ(learning_rate_factor(2), std::sqrt(2.0));
+}
+
+}  // namespace
+}  // namespace tega::trainer
