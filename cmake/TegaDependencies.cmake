@@ -82,6 +82,21 @@ if(TEGA_WITH_ARAVIS)
   endif()
 endif()
 
+# cpp-httplib: `tega serve`, the browser player's HTTP server. Debian builds
+# it as a library with OpenSSL, zlib and Brotli; its pkg-config file carries
+# the matching CPPHTTPLIB_* definitions, without which the header's classes
+# would not match the library's.
+set(TEGA_HAVE_HTTPLIB OFF)
+find_package(PkgConfig QUIET)
+if(PkgConfig_FOUND)
+  pkg_check_modules(HTTPLIB QUIET IMPORTED_TARGET cpp-httplib)
+endif()
+if(HTTPLIB_FOUND)
+  set(TEGA_HAVE_HTTPLIB ON)
+else()
+  message(STATUS "tega: cpp-httplib not found (libcpp-httplib-dev): tega serve is off")
+endif()
+
 set(TEGA_HAVE_TORCH OFF)
 if(TEGA_BUILD_AVATAR)
   find_package(Torch QUIET)

@@ -70,6 +70,9 @@ int main(int argc, char** argv) {
   tega::cli::add_inspect_command(app);
   tega::cli::add_export_command(app);
 #endif
+#ifdef TEGA_HAVE_SERVE
+  tega::cli::add_serve_command(app);
+#endif
   tega::cli::add_run_command(app);
   tega::cli::add_status_command(app);
 #ifdef TEGA_HAVE_REPORT

@@ -158,6 +158,7 @@ PosedGaussians AvatarModel::pose(const FrameInput& frame, const Phase& phase) {
       const at::Tensor s = shading.view({-1, 1, 1});
       dc = dc * s + (0.5 / kShConstant) * (s - 1.0);
       rest = rest * s;
+      out.shading = shading;
     }
     out.sh = used > 1 ? at::cat({dc, rest}, 1) : dc;
     out.sh_degree = phase.sh_degree;

@@ -46,6 +46,9 @@ struct PosedGaussians {
   at::Tensor sh;           // [N,(sh_degree+1)²,3] SH coefficients with the shading folded in
   int sh_degree = 0;       // the degree they hold (the rasterizer's setting)
   at::Tensor opacities;    // [N] in (0,1)
+  // [N] the dynamic shading S > 0 folded into `sh`, undefined when the phase
+  // has no shading; tega serve streams it apart from the static coefficients.
+  at::Tensor shading;
   at::Tensor world_std_per_scale;  // [N,3] world std per unit of exp(log_scale) (no grad)
   nn::Latents latents;     // this frame's latents (undefined when the field is off)
   // The longest Δμ applied, as [5] double (no grad): its length (metres), the
