@@ -1,20 +1,27 @@
 #include "tega/trainer/data_parallel.h"
 
+#include <chrono>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include "tega/core/error.h"
 
-// libtorch's c10d with Gloo (Debian: libtorch-dev with libgloo-dev's headers; PyTorch's wheels).
-#if __has_include(<torch/csrc/distributed/c10d/ProcessGroupGloo.hpp>) && __has_include(<gloo/rendezvous/store.h>)
+// libtorch's c10d: its stores always (the rendezvous and the host numbers), Gloo for gradients on
+// the CPU where its headers are (Debian: libgloo-dev), NCCL for gradients on GPUs where libtorch
+// was built with it (PyTorch's own libtorch; Debian's has no CUDA).
+#if __has_include(<torch/csrc/distributed/c10d/FileStore.hpp>)
 #define TEGA_HAVE_C10D 1
 #include <torch/csrc/distributed/c10d/FileStore.hpp>
 #include <torch/csrc/distributed/c10d/PrefixStore.hpp>
+#include <torch/version.h>
+#if __has_include(<gloo/rendezvous/store.h>) && __has_include(<torch/csrc/distributed/c10d/ProcessGroupGloo.hpp>)
+#define TEGA_HAVE_GLOO 1
 #include <torch/csrc/distributed/c10d/ProcessGroupGloo.hpp>
+#endif
 #ifdef USE_C10D_NCCL
 #include <torch/csrc/distributed/c10d/ProcessGroupNCCL.hpp>
 #endif
-#include <torch/version.h>
 #endif
 
 namespace tega::trainer {
@@ -29,25 +36,32 @@ using CollectiveGroup = c10d::Backend;
 using CollectiveGroup = c10d::ProcessGroup;
 #endif
 
+// A process waits this long for the others (the first process's checkpoints and held-out renders
+// at 4M Gaussians take minutes).
+constexpr auto kPatience = std::chrono::minutes(30);
+
 }  // namespace
 
 struct DataParallel::Groups {
   c10::intrusive_ptr<c10d::Store> store;
-  c10::intrusive_ptr<CollectiveGroup> gradients, host;
+  c10::intrusive_ptr<CollectiveGroup> gradients;
+  int64_t host_round = 0;
 };
 
-namespace {
-
-c10::intrusive_ptr<CollectiveGroup> gloo_group(const c10::intrusive_ptr<c10d::Store>& store, int rank, int world) {
-  auto options = c10d::ProcessGroupGloo::Options::create();
-  options->devices.push_back(c10d::ProcessGroupGloo::createDeviceForHostname("127.0.0.1"));
-  return c10::make_intrusive<c10d::ProcessGroupGloo>(store, rank, world, options);
+bool DataParallel::available(const at::Device& device) {
+#ifdef USE_C10D_NCCL
+  if (device.is_cuda()) return true;
+#endif
+#ifdef TEGA_HAVE_GLOO
+  return true;
+#else
+  (void)device;
+  return false;
+#endif
 }
-
-}  // namespace
-
 #else
 struct DataParallel::Groups {};
+bool DataParallel::available(const at::Device&) { return false; }
 #endif
 
 DataParallel::DataParallel() = default;
@@ -59,26 +73,30 @@ DataParallel::DataParallel(const ParallelRank& rank, const at::Device& device) :
                 " does not exist");
   if (world_ == 1) return;
   if (rank.rendezvous.empty()) throw Error("data-parallel training needs a rendezvous file");
-#ifndef TEGA_HAVE_C10D
-  throw Error("training on several processes needs libtorch's c10d with Gloo, which this build lacks (libgloo-dev)");
-#else
+  if (!available(device))
+    throw Error(std::string("training on several processes needs libtorch's c10d with ") +
+                (device.is_cuda() ? "NCCL, which this libtorch lacks" : "Gloo's headers, which this build lacks (libgloo-dev)"));
+#ifdef TEGA_HAVE_C10D
   groups_ = std::make_unique<Groups>();
   groups_->store = c10::make_intrusive<c10d::FileStore>(rank.rendezvous.string(), world_);
-  const auto host_store = c10::make_intrusive<c10d::PrefixStore>("host", groups_->store);
+  groups_->store->setTimeout(kPatience);
   const auto gradient_store = c10::make_intrusive<c10d::PrefixStore>("gradients", groups_->store);
-  groups_->host = gloo_group(host_store, rank_, world_);
 #ifdef USE_C10D_NCCL
   if (device.is_cuda()) {
     groups_->gradients = c10::make_intrusive<c10d::ProcessGroupNCCL>(gradient_store, rank_, world_);
     return;
   }
 #endif
-  (void)device;
-  groups_->gradients = gloo_group(gradient_store, rank_, world_);
+#ifdef TEGA_HAVE_GLOO
+  auto options = c10d::ProcessGroupGloo::Options::create();
+  options->devices.push_back(c10d::ProcessGroupGloo::createDeviceForHostname("127.0.0.1"));
+  options->timeout = kPatience;
+  groups_->gradients = c10::make_intrusive<c10d::ProcessGroupGloo>(gradient_store, rank_, world_, options);
+#endif
 #endif
 }
 
-// Alone, or without c10d (then no group exists beyond one process), these are the identity.
+// Alone, these are the identity (and without c10d no group exists beyond one process).
 void DataParallel::reduce(const std::vector<at::Tensor>& tensors, bool mean) {
   if (alone() || tensors.empty()) return;
 #ifdef TEGA_HAVE_C10D
@@ -100,22 +118,36 @@ void DataParallel::reduce(const std::vector<at::Tensor>& tensors, bool mean) {
 void DataParallel::average(const std::vector<at::Tensor>& tensors) { reduce(tensors, true); }
 void DataParallel::sum(const std::vector<at::Tensor>& tensors) { reduce(tensors, false); }
 
+// Through the rendezvous store, not a collective group: host numbers then never wait for a GPU
+// stream, and need neither Gloo nor NCCL. Each round, each process sets its key and reads all.
 std::vector<double> DataParallel::host_sum(const std::vector<double>& values) {
   if (alone()) return values;
 #ifdef TEGA_HAVE_C10D
-  std::vector<at::Tensor> packed{at::tensor(values, at::kDouble)};
-  groups_->host->allreduce(packed)->wait();
-  const at::Tensor& sums = packed[0];
-  return {sums.data_ptr<double>(), sums.data_ptr<double>() + sums.numel()};
+  const int64_t round = groups_->host_round++;
+  const auto key = [&](int64_t r, int process) { return "host/" + std::to_string(r) + "/" + std::to_string(process); };
+  std::vector<uint8_t> bytes(values.size() * sizeof(double));
+  std::memcpy(bytes.data(), values.data(), bytes.size());
+  groups_->store->set(key(round, rank_), bytes);
+  std::vector<double> sums(values.size(), 0.0);
+  for (int process = 0; process < world_; ++process) {
+    const std::vector<uint8_t> theirs = groups_->store->get(key(round, process));  // waits for it
+    if (theirs.size() != bytes.size()) throw Error("data-parallel training: the processes disagree on what they sum");
+    for (size_t i = 0; i < values.size(); ++i) {
+      double value;
+      std::memcpy(&value, theirs.data() + i * sizeof(double), sizeof(double));
+      sums[i] += value;
+    }
+  }
+  // Every process has read round - 2's keys before it set those of round - 1, which this one has
+  // read: its own key of round - 2 is no longer wanted.
+  if (round >= 2) groups_->store->deleteKey(key(round - 2, rank_));
+  return sums;
 #else
   return values;
 #endif
 }
 
-void DataParallel::barrier() {
-  if (alone()) return;
-  host_sum({0.0});  // Gloo's barrier is an all-reduce too; this one keeps to the host group
-}
+void DataParallel::barrier() { host_sum({0.0}); }
 
 double learning_rate_factor(int views_per_step) { return std::sqrt(static_cast<double>(std::max(1, views_per_step))); }
 

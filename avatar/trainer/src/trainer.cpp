@@ -239,8 +239,8 @@ class Run {
     summary.gaussians = model_.gaussians.size();
     summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     // An interrupted run (a scheduler's time limit, say) has seconds left, not the held-out renders' time.
+    check_replicas_agree();  // before the first process alone renders the held-out views
     summary.heldout_psnr = summary.interrupted || !parallel_.leads() ? std::numeric_limits<double>::quiet_NaN() : heldout_psnr();
-    check_replicas_agree();
     summary.checkpoint = run_dir_ / kCheckpoint;
     if (profiler_.enabled()) {
       summary.milliseconds_per_step = profiler_.mean_milliseconds(iteration_ - first);

@@ -4,9 +4,9 @@
 // averaged over the processes before each one's identical optimiser step, so the replicas stay
 // equal, as does every decision taken from them (densification, roll-backs, stopping).
 //
-// Two groups over one rendezvous file: the gradients' (NCCL for CUDA tensors where libtorch has
-// it, else Gloo) and a host group (Gloo, CPU) for the few numbers every process must agree on,
-// which then never waits for the GPU's stream.
+// The processes meet through a rendezvous file (c10d's file store). The gradients go through a
+// collective group (NCCL for CUDA tensors where libtorch has it, Gloo on the CPU); the few numbers
+// every process must agree on go through the store itself, which never waits for a GPU stream.
 
 #include <ATen/ATen.h>
 
@@ -26,6 +26,9 @@ class DataParallel {
   ~DataParallel();
   DataParallel(const DataParallel&) = delete;
   DataParallel& operator=(const DataParallel&) = delete;
+
+  // Whether this build can train on several processes on `device`.
+  static bool available(const at::Device& device);
 
   bool alone() const { return world_ == 1; }
   bool leads() const { return rank_ == 0; }  // the process that writes checkpoints, metrics and logs
