@@ -47,6 +47,7 @@ struct Served : test::TinyRun {
   }
 };
 
+// Callers wrap it in ASSERT_NO_FATAL_FAILURE: with no answer there is no body to read next.
 void expect_status(const httplib::Result& result, int status, const std::string& path) {
   ASSERT_TRUE(result) << path << ": no answer (" << httplib::to_string(result.error()) << ")";
   EXPECT_EQ(result->status, status) << path << ": " << result->body;
@@ -133,11 +134,11 @@ TEST(Server, UnknownNamesAndPathsOutsideTheRunAre404AndItKeepsServing) {
         "/api/runs/run/images/cam00/..%2F..%2Fdataset.json.png", "/api/runs/..%2Frun/index.json",
         "/api/runs/run/frames/..%2F..%2Frun%2Frun.json.bin", "/api/runs/run/images/cam00/blink_000000.png"}) {
     const auto answer = s.get(path);
-    expect_status(answer, 404, path);
+    ASSERT_NO_FATAL_FAILURE(expect_status(answer, 404, path));
     EXPECT_EQ(answer->body.find("not for the browser"), std::string::npos) << path;
     EXPECT_NO_THROW(json::parse(answer->body)["error"].get<std::string>()) << path << ": " << answer->body;
   }
-  expect_status(s.get("/api/runs/run/index.json"), 200, "index after the 404s");
+  ASSERT_NO_FATAL_FAILURE(expect_status(s.get("/api/runs/run/index.json"), 200, "index after the 404s"));
 }
 
 TEST(Server, ByteRangesBeyondABodyAre416AndOthersArePartial) {
@@ -145,14 +146,14 @@ TEST(Server, ByteRangesBeyondABodyAre416AndOthersArePartial) {
   const std::string path = "/api/runs/run/frames/smile_000000.bin";
   const std::string whole = s.get(path)->body;
   const auto partial = s.get(path, {httplib::make_range_header({{10, 19}})});
-  expect_status(partial, 206, "bytes 10-19");
+  ASSERT_NO_FATAL_FAILURE(expect_status(partial, 206, "bytes 10-19"));
   EXPECT_EQ(partial->body, whole.substr(10, 10));
   const auto beyond = s.get(path, {httplib::make_range_header({{int64_t(whole.size()) + 5, -1}})});
-  expect_status(beyond, 416, "a range past the end");
+  ASSERT_NO_FATAL_FAILURE(expect_status(beyond, 416, "a range past the end"));
   EXPECT_EQ(beyond->get_header_value("Content-Range"), "bytes */" + std::to_string(whole.size()));
   expect_status(s.get("/api/runs/run/images/cam00/smile_000000.png", {httplib::make_range_header({{1 << 20, -1}})}),
                 416, "an image range past the end");
-  expect_status(s.get(path), 200, "the frame after the 416s");
+  ASSERT_NO_FATAL_FAILURE(expect_status(s.get(path), 200, "the frame after the 416s"));
 }
 
 std::string error_of_starting(const fs::path& target) {
@@ -190,8 +191,8 @@ TEST(Server, AWorkspaceServesEachSubjectsRun) {
   EXPECT_EQ(runs[0]["id"], "alice");
   const json index = json::parse(s.get("/api/runs/alice/index.json")->body);
   EXPECT_TRUE(index["eval"]["models"].is_array());
-  expect_status(s.get("/api/runs/alice/frames/blink_000000.bin"), 200, "alice's frame");
-  expect_status(s.get("/api/runs/run/index.json"), 404, "the run by its directory name");
+  ASSERT_NO_FATAL_FAILURE(expect_status(s.get("/api/runs/alice/frames/blink_000000.bin"), 200, "alice's frame"));
+  ASSERT_NO_FATAL_FAILURE(expect_status(s.get("/api/runs/run/index.json"), 404, "the run by its directory name"));
 }
 
 TEST(SafePath, OnlyPathsThatResolveInsideTheRootPass) {
