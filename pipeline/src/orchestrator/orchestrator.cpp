@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <algorithm>
 #include <map>
+#include <vector>
 #include <optional>
 
 #include "tega/core/error.h"
@@ -30,10 +31,11 @@ struct ShardRun {
   std::vector<std::string> command;
   std::string started;
   std::string output_hash;  // once done
-  // Its jobs, by id: one, or one per part of a split shard (StageKind::split).
-  std::map<std::string, Job> jobs;
+  // Its jobs: one, or one per part of a split shard (StageKind::split), in order.
+  std::vector<Job> jobs;
   size_t jobs_running = 0;
-  double seconds = 0;        // its longest job's
+  Clock::time_point launched;
+  double seconds = 0;        // its job's; a split shard's from its launch to its last job's end
   long peak_rss_kib = 0;     // its largest job's
   std::string job_failure;   // the first failed job's error, reported when the last has finished
 };
@@ -225,26 +227,27 @@ class Run {
         part.id = s.id + "#" + std::to_string(k + 1);
         part.argv.insert(part.argv.end(), parts[k].begin(), parts[k].end());
         part.log_file = ws_.log_file(stage.name(), subject.name + "#" + std::to_string(k + 1));
-        s.jobs.emplace(part.id, std::move(part));
+        s.jobs.push_back(std::move(part));
       }
     } else {
-      s.jobs.emplace(job.id, std::move(job));
+      s.jobs.push_back(std::move(job));
     }
 
     s.started = utc_now();
+    s.launched = Clock::now();
     s.seconds = 0;
     s.peak_rss_kib = 0;
     s.job_failure.clear();
     s.jobs_running = s.jobs.size();
-    const Job& first = s.jobs.begin()->second;
+    const Job& first = s.jobs.front();
     write_shard_state(ws_.state_file(stage.name(), subject.name), {"running", "", first.log_file.string(), s.started, ""});
     spdlog::info("{} started{}{} (log: {})", s.id,
                  s.jobs.size() > 1 ? " as " + std::to_string(s.jobs.size()) + " jobs" : "",
                  first.resources.gpu_device.empty() ? "" : " on " + first.resources.gpu_device,
                  s.jobs.size() > 1 ? ws_.log_file(stage.name(), subject.name + "#*").string() : first.log_file.string());
     s.phase = Phase::queued;
-    for (const auto& [id, part] : s.jobs) {
-      job_shard_[id] = static_cast<size_t>(&s - shards_.data());
+    for (const Job& part : s.jobs) {
+      job_shard_[part.id] = static_cast<size_t>(&s - shards_.data());
       executor_.submit(part);
     }
   }
@@ -253,14 +256,14 @@ class Run {
     const auto found = job_shard_.find(result.id);
     if (found == job_shard_.end()) return;
     ShardRun& s = shards_[found->second];
-    const auto job = s.jobs.find(result.id);
+    const auto job = std::find_if(s.jobs.begin(), s.jobs.end(), [&](const Job& j) { return j.id == result.id; });
     if (job == s.jobs.end()) return;
-    const fs::path log = job->second.log_file;
+    const fs::path log = job->log_file;
     if (result.requeue) {
       spdlog::warn("{}: {}", result.id, result.failure);
       try {
         if (s.jobs.size() > 1) {
-          executor_.submit(job->second);  // the other parts' files stay in the staging directory
+          executor_.submit(*job);  // the other parts' files stay in the staging directory
         } else {
           launch(s);
         }
@@ -270,7 +273,7 @@ class Run {
       return;
     }
     --s.jobs_running;
-    s.seconds = std::max(s.seconds, result.seconds);
+    s.seconds = s.jobs.size() > 1 ? std::chrono::duration<double>(Clock::now() - s.launched).count() : result.seconds;
     s.peak_rss_kib = std::max(s.peak_rss_kib, result.peak_rss_kib);
     if (!result.succeeded && s.job_failure.empty()) {
       s.job_failure = (s.jobs.size() > 1 ? result.id + ": " : "") + result.failure + ": " + last_error_line(log) +
@@ -310,7 +313,7 @@ class Run {
     m.fingerprint = s.fingerprint;
     m.key = s.fingerprint.key();
     m.command = s.command;
-    m.log = s.jobs.begin()->second.log_file.string();  // a split shard's first part's
+    m.log = s.jobs.front().log_file.string();  // a split shard's first part's
     m.started = s.started;
     m.finished = utc_now();
     m.seconds = seconds;
@@ -326,7 +329,7 @@ class Run {
   void fail(ShardRun& s, const std::string& error) {
     const Stage& stage = stage_of(s);
     const std::string& subject = subject_of(s);
-    const fs::path log = s.jobs.empty() ? ws_.log_file(stage.name(), subject) : s.jobs.begin()->second.log_file;
+    const fs::path log = s.jobs.empty() ? ws_.log_file(stage.name(), subject) : s.jobs.front().log_file;
     write_shard_state(ws_.state_file(stage.name(), subject), {"failed", error, log.string(), s.started, utc_now()});
     ++summary_.failed;
     summary_.problems.push_back(s.id + " failed: " + error);
