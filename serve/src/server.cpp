@@ -16,6 +16,7 @@
 #include "tega/serve/posed_frame.h"
 #include "tega/serve/run_catalog.h"
 #include "tega/serve/safe_path.h"
+#include "tega/tools/gaussian_spz.h"
 #include "tega/tools/load_run.h"
 #include "web_assets.h"
 
@@ -79,6 +80,8 @@ struct Server::Impl {
   Options options;
   std::vector<std::unique_ptr<ServedRun>> runs;
   std::string runs_json;
+  std::map<std::string, std::string> splats;  // file name -> the SPZ file's bytes
+  std::string splats_json;
   FrameCache cache;
   httplib::Server http;
   std::thread listener;
@@ -100,6 +103,15 @@ struct Server::Impl {
       runs.push_back(std::move(run));
     }
     runs_json = nlohmann::json{{"runs", listing}}.dump();
+    nlohmann::json splat_listing = nlohmann::json::array();
+    for (const fs::path& file : options.splats) {
+      const tools::SpzCloud cloud = tools::read_gaussian_spz(file);  // names the file when it is no SPZ
+      const std::string name = file.filename().string();
+      if (!splats.emplace(name, read_text_file(file)).second)
+        throw Error(file, "has the name of another --splat file; the page opens them by name");
+      splat_listing.push_back({{"name", name}, {"url", "/api/splats/" + name}, {"gaussians", cloud.gaussians.size()}});
+    }
+    splats_json = nlohmann::json{{"splats", splat_listing}}.dump();
     routes();
   }
 
@@ -117,6 +129,14 @@ struct Server::Impl {
     });
     http.Get("/api/runs", [this](const httplib::Request&, httplib::Response& res) {
       res.set_content(runs_json, "application/json");
+    });
+    http.Get("/api/splats", [this](const httplib::Request&, httplib::Response& res) {
+      res.set_content(splats_json, "application/json");
+    });
+    http.Get(R"(/api/splats/([^/]+))", [this](const httplib::Request& req, httplib::Response& res) {
+      const auto splat = splats.find(req.matches[1].str());
+      if (splat == splats.end()) return answer_error(res, 404, "no splat file '" + req.matches[1].str() + "' is served");
+      answer_bytes(req, res, splat->second, "application/octet-stream");
     });
     http.Get(R"(/api/runs/([^/]+)/index\.json)", [this](const httplib::Request& req, httplib::Response& res) {
       if (ServedRun* run = run_or_404(req, res)) res.set_content(run->index_json, "application/json");

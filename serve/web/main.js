@@ -10,10 +10,14 @@
 // as a PNG data URL in #still-png and its frame rate in #render-fps.
 // &take_load=1 also loads every frame of the frame's take and reports how
 // long that took in #take-load-ms.
+//
+// ?splat=NAME&camera=NAME shows an SPZ file served with `tega serve --splat`
+// from a dataset camera of the run (its render in #still-png with &still=1).
 
 import { Orbit, cameraCentre, resized } from './camera.js';
 import { projectSplats } from './projection.js';
 import { SplatRenderer } from './renderer.js';
+import { decodeSpz } from './spz.js';
 import { decodeFrame, decodeStatic } from './stream.js';
 
 const params = new URLSearchParams(location.search);
@@ -188,6 +192,22 @@ function runStill(player) {
   $('frame-label').textContent = player.frameId;
 }
 
+// The file's Gaussians in place of the run's, drawn once from a dataset camera.
+async function runSplat(player, name) {
+  const runs = fetchSync('/api/runs', false).runs;
+  await player.openRun(params.get('run') || runs[0].id);
+  player.cameraName = params.get('camera') || player.cameras[0].name;
+  if (!player.cameras.some((c) => c.name === player.cameraName)) throw new Error(`no camera ${player.cameraName}`);
+  const url = `/api/splats/${encodeURIComponent(name)}`;
+  const splat = await decodeSpz(await fetchAsync(url, true), player.fixed.background, url);
+  player.fixed = splat.fixed;
+  player.frameId = name;
+  player.draw(splat.frame);
+  $('still-png').textContent = $('render').toDataURL('image/png');
+  $('gaussians').textContent = splat.fixed.count;
+  $('frame-label').textContent = name;
+}
+
 async function runInteractive(player) {
   const runs = (await fetchAsync('/api/runs', false)).runs;
   const runSelect = $('run');
@@ -338,7 +358,9 @@ function fail(error) {
 try {
   document.body.classList.toggle('still', still);
   const player = new Player();
-  if (still) {
+  if (params.get('splat')) {
+    runSplat(player, params.get('splat')).then(() => (document.body.dataset.state = still ? 'done' : 'ready'), fail);
+  } else if (still) {
     runStill(player);
     document.body.dataset.state = 'done';
   } else {

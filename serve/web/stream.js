@@ -74,7 +74,7 @@ export function decodeFrame(buffer, what = 'frame') {
 }
 
 // R diag(v) Rᵀ from a unit quaternion (w, x, y, z), packed as 6 values.
-function setCovariance(out, offset, [w, x, y, z], v) {
+export function setCovariance(out, offset, [w, x, y, z], v) {
   const r = [
     1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
     2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),

@@ -10,11 +10,13 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <regex>
 
 #include "tega/core/files.h"
 #include "tega/core/image.h"
+#include "tega/tools/gaussian_spz.h"
 #include "serve_process.h"
 #include "tiny_run.h"
 
@@ -72,12 +74,15 @@ std::string element_text(const std::string& dom, const std::string& id) {
   return "";
 }
 
+// `asynchronous`: the page finishes after its load event (an SPZ file is unpacked by the browser's
+// DecompressionStream): Chromium's virtual time lets it before the DOM is read.
 PageResult page(const std::string& browser, const test::ServeProcess& server, const fs::path& scratch,
-                const std::string& query) {
+                const std::string& query, bool asynchronous = false) {
   const std::string dom = run_command("timeout 180 " + browser +
                                       " --headless=new --no-sandbox --use-angle=swiftshader --enable-unsafe-swiftshader"
                                       " --user-data-dir=" + (scratch / "profile").string() +
-                                      " --dump-dom '" + server.url() + "/?" + query + "' 2>/dev/null");
+                                      (asynchronous ? " --virtual-time-budget=30000" : "") + " --dump-dom '" +
+                                      server.url() + "/?" + query + "' 2>/dev/null");
   PageResult result;
   std::smatch state;
   if (std::regex_search(dom, state, std::regex("<body[^>]*data-state=\"([a-z]+)\""))) result.state = state[1];
@@ -147,6 +152,40 @@ TEST(Page, RendersADatasetFrameAsTegaRenderDoesAndScrubsToAnother) {
   const PageResult unknown = page(browser, server, tiny.tmp.path(), "still=1&frame=nosuch&camera=cam00");
   EXPECT_EQ(unknown.state, "error");
   EXPECT_NE(unknown.error.find("no frame nosuch"), std::string::npos) << unknown.error;
+}
+
+// `tega export --format spz` read by the page: its render of the file from a dataset camera
+// against tega's reading of the same file, rendered by tega's rasterizer.
+TEST(Page, LoadsAnExportedSpzFile) {
+  const std::string browser = chromium();
+  if (browser.empty()) GTEST_SKIP() << "no chromium (Debian package chromium): the page is not tested";
+  test::TinyRun tiny;
+  const fs::path spz = tiny.tmp / "smile.spz";
+  ASSERT_EQ(std::system((std::string(TEGA_EXECUTABLE) + " -q export --model " + tiny.run.string() +
+                         " --frame smile_000000 --device cpu --out " + spz.string())
+                            .c_str()),
+            0);
+  test::ServeProcess server(tiny.run, {"--splat", spz.string()});
+  httplib::Client client("127.0.0.1", server.port);
+  for (int attempt = 0; attempt < 600 && !client.Get("/api/splats"); ++attempt)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  EXPECT_EQ(client.Get("/api/splats/nosuch.spz")->status, 404);
+
+  const PageResult shown = page(browser, server, tiny.tmp.path(), "still=1&splat=smile.spz&camera=cam00", true);
+  ASSERT_EQ(shown.state, "done") << shown.error;
+  ASSERT_EQ(shown.image.width, test::TinyRun::kWidth);
+
+  const Camera& camera = tiny.dataset.rig.camera("cam00");
+  const tools::SpzCloud cloud = tools::read_gaussian_spz(spz);
+  const at::Tensor background = at::tensor(tiny.avatar->options.background).to(at::kFloat);  // the page's, the run's
+  const at::Tensor rgb = tools::render_cloud(cloud.gaussians, camera, background, cloud.antialiased);
+  Image8 expected(camera.width, camera.height, 3);
+  const at::Tensor bytes = (rgb.clamp(0, 1) * 255).round().to(at::kByte).permute({1, 2, 0}).contiguous();
+  std::memcpy(expected.pixels.data(), bytes.data_ptr<uint8_t>(), expected.pixels.size());
+  const Image8 matte = read_image_u8(tiny.dataset.image_path("cam00", "smile_000000"));
+  const double psnr = masked_psnr(shown.image, expected, matte);
+  std::cout << "page's SPZ render vs tega's of the same file, inside the mask: " << psnr << " dB\n";
+  EXPECT_GE(psnr, 35.0);
 }
 
 }  // namespace

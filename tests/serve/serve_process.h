@@ -12,6 +12,7 @@
 #include <chrono>
 #include <filesystem>
 #include <string>
+#include <vector>
 #include <thread>
 
 namespace tega::test {
@@ -32,12 +33,17 @@ struct ServeProcess {
   int port = free_port();
   pid_t pid = -1;
 
-  explicit ServeProcess(const std::filesystem::path& target) {
+  // `more`: further arguments of `tega serve` (e.g. --splat FILE).
+  explicit ServeProcess(const std::filesystem::path& target, std::vector<std::string> more = {}) {
+    std::vector<std::string> arguments{TEGA_EXECUTABLE, "-q",          "serve", target.string(), "--port",
+                                       std::to_string(port), "--device", "cpu"};
+    arguments.insert(arguments.end(), more.begin(), more.end());
+    std::vector<char*> argv;
+    for (auto& a : arguments) argv.push_back(a.data());
+    argv.push_back(nullptr);
     pid = fork();
     if (pid == 0) {
-      const std::string path = target.string(), port_text = std::to_string(port);
-      execl(TEGA_EXECUTABLE, TEGA_EXECUTABLE, "-q", "serve", path.c_str(), "--port", port_text.c_str(), "--device",
-            "cpu", static_cast<char*>(nullptr));
+      execv(TEGA_EXECUTABLE, argv.data());
       _exit(127);
     }
   }

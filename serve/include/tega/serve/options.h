@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace tega::serve {
 
@@ -29,6 +30,9 @@ struct Options {
   double pose_wait_seconds = 20;
   // Threads answering requests.
   int threads = 8;
+  // SPZ files (`tega export --format spz`) the page may open beside the runs, by file name
+  // (?splat=NAME), seen from the first run's cameras.
+  std::vector<std::filesystem::path> splats;
 };
 
 }  // namespace tega::serve

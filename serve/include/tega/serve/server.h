@@ -9,6 +9,7 @@
 //   GET /api/runs/<run>/static.bin                 what no frame changes (frame_stream.h)
 //   GET /api/runs/<run>/frames/<frame>.bin         one frame's posed Gaussians (frame_stream.h)
 //   GET /api/runs/<run>/images/<camera>/<frame>.png  the dataset's image
+//   GET /api/splats, /api/splats/<name>            the --splat SPZ files, by file name
 //
 // Nothing else is served: run, camera and frame names are looked up among
 // the run's own, and files are read only where they resolve inside the
