@@ -24,6 +24,9 @@ void add_serve_command(CLI::App& app) {
     return true;
   }, "Megabytes of encoded frames kept for reuse (default 512).");
   cmd->add_option("--threads", options->threads, "Threads answering requests.")->capture_default_str();
+  cmd->add_option("--meshes", options->meshes,
+                  "A directory of tracked meshes (tega track's TRACKED/<take>, held-out takes, new performances) every "
+                  "run plays as a take of its own (repeatable).");
   cmd->add_option("--splat", options->splats,
                   "An SPZ file (tega export --format spz) the page opens by name, ?splat=NAME (repeatable).");
   cmd->callback([options] { serve::serve(*options); });

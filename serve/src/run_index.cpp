@@ -52,13 +52,18 @@ json eval_summary(const fs::path& eval_json) {
 }  // namespace
 
 json run_index(const std::string& run_id, const Dataset& dataset, const StaticPart& static_part, double fps,
-               const fs::path& eval_json) {
+               const fs::path& eval_json, const std::vector<MeshTake>& mesh_takes) {
   json cameras = json::array();
   for (const Camera& c : dataset.rig.cameras) cameras.push_back(camera_json(c, dataset));
   json takes = json::array();
   for (const DatasetFrame& f : dataset.frames) {
     if (takes.empty() || takes.back()["name"] != f.sequence) takes.push_back({{"name", f.sequence}, {"frames", json::array()}});
     takes.back()["frames"].push_back({{"id", f.id}, {"split", split_of(dataset.train.frames, dataset.test.frames, f.id)}});
+  }
+  for (const MeshTake& take : mesh_takes) {
+    json frames = json::array();
+    for (const std::string& id : take.frames) frames.push_back({{"id", id}, {"split", "meshes"}});
+    takes.push_back({{"name", take.name}, {"frames", frames}});
   }
   const std::string base = "/api/runs/" + run_id;
   return {{"format", "tega-serve-index"},

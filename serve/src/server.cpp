@@ -18,6 +18,7 @@
 #include "tega/serve/safe_path.h"
 #include "tega/tools/gaussian_spz.h"
 #include "tega/tools/load_run.h"
+#include "tega/tools/render_avatar.h"
 #include "web_assets.h"
 
 // Last: through <resolv.h> it defines _res, a name Eigen's headers use.
@@ -35,6 +36,7 @@ struct ServedRun {
   std::string static_bytes;
   std::string index_json;
   std::map<std::string, size_t> frames;  // id -> index in the dataset's frames
+  std::map<std::string, fs::path> mesh_frames;  // id -> a --meshes file
   std::timed_mutex posing;               // the model poses one frame at a time
 };
 
@@ -96,7 +98,19 @@ struct Server::Impl {
       run->static_bytes = encode_static(part);
       const Dataset& dataset = run->loaded.dataset;
       for (size_t i = 0; i < dataset.frames.size(); ++i) run->frames[dataset.frames[i].id] = i;
-      run->index_json = run_index(location.id, dataset, part, options.fps, location.eval_json).dump();
+      std::vector<MeshTake> mesh_takes;
+      for (const fs::path& directory : options.meshes) {
+        MeshTake take{fs::absolute(directory).lexically_normal().filename().string(), {}};
+        if (take.name.empty()) take.name = fs::absolute(directory).lexically_normal().parent_path().filename().string();
+        for (const fs::path& file : tools::mesh_files(directory)) {
+          const std::string id = take.name + "." + file.stem().string();
+          if (run->frames.count(id) || !run->mesh_frames.emplace(id, file).second)
+            throw Error(file, "would be frame " + id + ", a name another frame has: give the directories other names");
+          take.frames.push_back(id);
+        }
+        mesh_takes.push_back(std::move(take));
+      }
+      run->index_json = run_index(location.id, dataset, part, options.fps, location.eval_json, mesh_takes).dump();
       listing.push_back({{"id", location.id}, {"run", location.run.string()}, {"dataset", dataset.root.string()},
                          {"gaussians", part.size()}, {"index", "/api/runs/" + location.id + "/index.json"}});
       run->location = std::move(location);
@@ -184,7 +198,9 @@ struct Server::Impl {
   void answer_frame(ServedRun& run, const httplib::Request& req, httplib::Response& res) {
     const std::string id = req.matches[2].str();
     const auto frame = run.frames.find(id);
-    if (frame == run.frames.end()) return answer_error(res, 404, "run " + run.location.id + " has no frame " + id);
+    const auto mesh = run.mesh_frames.find(id);
+    if (frame == run.frames.end() && mesh == run.mesh_frames.end())
+      return answer_error(res, 404, "run " + run.location.id + " has no frame " + id);
     const std::string key = run.location.id + "/" + id;
     std::shared_ptr<const std::string> bytes = cache.find(key);
     if (!bytes) {
@@ -196,7 +212,12 @@ struct Server::Impl {
       bytes = cache.find(key);  // posed while this request waited
       if (!bytes) {
         const Dataset& dataset = run.loaded.dataset;
-        const tools::RenderFrame posed = tools::dataset_frames(dataset, {dataset.frames[frame->second].id}).front();
+        // Mesh files in the head pose of the first training frame, as `tega render --meshes` poses them.
+        const tools::RenderFrame posed =
+            frame != run.frames.end()
+                ? tools::dataset_frames(dataset, {dataset.frames[frame->second].id}).front()
+                : tools::mesh_frame(mesh->second, dataset.template_mesh.num_vertices(),
+                                    dataset.frame(dataset.train.frames.front()).head_to_world, /*head_space=*/false);
         bytes = std::make_shared<const std::string>(encode_frame(posed_frame(*run.loaded.avatar, posed)));
         cache.insert(key, bytes);
       }

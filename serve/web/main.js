@@ -135,7 +135,7 @@ class Player {
   showCapturedImage() {
     const image = $('captured');
     const split = this.frameInfo(this.frameId);
-    if (this.cameraName === 'free' || !split) {
+    if (this.cameraName === 'free' || !split || split.frame.split === 'meshes') {  // mesh files have no images
       image.hidden = true;
       return;
     }

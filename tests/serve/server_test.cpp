@@ -109,6 +109,46 @@ TEST(Server, StaticPartAndFramesAreThePosedAvatarsStream) {
   EXPECT_NE(s.get("/api/runs/run/frames/smile_000000.bin")->body, s.get("/api/runs/run/frames/blink_000000.bin")->body);
 }
 
+// A directory of mesh files (a tracked take, a new performance) plays as a take of its own.
+TEST(Server, MeshDirectoriesAreTakesOfTheirOwn) {
+  test::TinyRun tiny;
+  const fs::path take = tiny.tmp / "performance";
+  fs::create_directories(take);
+  fs::copy_file(tiny.dataset.mesh_path("blink_000000"), take / "000000.bin");
+  fs::copy_file(tiny.dataset.mesh_path("smile_000000"), take / "000001.bin");
+  Options options;
+  options.target = tiny.run;
+  options.port = 0;
+  options.device = "cpu";
+  options.meshes = {take};
+  Server server(options);
+  server.start();
+  httplib::Client client("127.0.0.1", server.port());
+
+  const auto index = client.Get("/api/runs/run/index.json");
+  ASSERT_TRUE(index);
+  const json takes = json::parse(index->body)["takes"];
+  ASSERT_EQ(takes.back()["name"], "performance");
+  EXPECT_EQ(takes.back()["frames"], json::parse(R"([{"id": "performance.000000", "split": "meshes"},
+                                                     {"id": "performance.000001", "split": "meshes"}])"));
+
+  tools::LoadedRun loaded = tools::load_run(tiny.run, "", "cpu");
+  const Dataset& dataset = loaded.dataset;
+  const RigidTransform pose = dataset.frame(dataset.train.frames.front()).head_to_world;
+  for (const std::string stem : {"000000", "000001"}) {
+    const auto frame = client.Get(("/api/runs/run/frames/performance." + stem + ".bin").c_str());
+    ASSERT_TRUE(frame);
+    ASSERT_EQ(frame->status, 200) << frame->body;
+    const tools::RenderFrame posed =
+        tools::mesh_frame(take / (stem + ".bin"), dataset.template_mesh.num_vertices(), pose, false);
+    EXPECT_EQ(frame->body, encode_frame(posed_frame(*loaded.avatar, posed))) << stem;
+  }
+  EXPECT_NE(client.Get("/api/runs/run/frames/performance.000000.bin")->body,
+            client.Get("/api/runs/run/frames/performance.000001.bin")->body);
+  EXPECT_EQ(client.Get("/api/runs/run/frames/performance.000002.bin")->status, 404);
+  EXPECT_EQ(client.Get("/api/runs/run/images/cam00/performance.000000.png")->status, 404);  // no captured image
+}
+
 TEST(Server, ImagesAreTheDatasetsFilesAndThePageIsServed) {
   Served s;
   const auto image = s.get("/api/runs/run/images/cam01/blink_000000.png");

@@ -100,8 +100,7 @@ std::vector<RenderFrame> dataset_frames(const Dataset& dataset, const std::vecto
   return frames;
 }
 
-std::vector<RenderFrame> mesh_sequence(const fs::path& directory, int template_vertices,
-                                       const RigidTransform& head_to_world, bool head_space) {
+std::vector<fs::path> mesh_files(const fs::path& directory) {
   if (!fs::is_directory(directory)) throw Error(directory, "is not a directory of meshes");
   std::vector<fs::path> files;
   for (const auto& entry : fs::directory_iterator(directory)) {
@@ -110,26 +109,35 @@ std::vector<RenderFrame> mesh_sequence(const fs::path& directory, int template_v
   }
   if (files.empty()) throw Error(directory, "holds no .bin, .obj or .ply mesh");
   std::sort(files.begin(), files.end());
-  std::vector<RenderFrame> frames;
-  for (const auto& file : files) {
-    RenderFrame frame;
-    frame.id = file.stem().string();
-    if (file.extension() == ".bin") {
-      frame.world_vertices = read_vertices_bin(file, template_vertices);
-    } else {
-      frame.world_vertices = read_mesh(file).positions;
-      if (frame.world_vertices.rows() != template_vertices)
-        throw Error(file, "has " + std::to_string(frame.world_vertices.rows()) + " vertices; the template has " +
-                              std::to_string(template_vertices));
-    }
-    if (head_space) {
-      const Eigen::Matrix3f r = head_to_world.R.cast<float>();
-      const Eigen::RowVector3f t = head_to_world.t.cast<float>().transpose();
-      frame.world_vertices = ((frame.world_vertices * r.transpose()).rowwise() + t).eval();
-    }
-    frame.head_to_world = head_to_world;
-    frames.push_back(std::move(frame));
+  return files;
+}
+
+RenderFrame mesh_frame(const fs::path& file, int template_vertices, const RigidTransform& head_to_world,
+                       bool head_space) {
+  RenderFrame frame;
+  frame.id = file.stem().string();
+  if (file.extension() == ".bin") {
+    frame.world_vertices = read_vertices_bin(file, template_vertices);
+  } else {
+    frame.world_vertices = read_mesh(file).positions;
+    if (frame.world_vertices.rows() != template_vertices)
+      throw Error(file, "has " + std::to_string(frame.world_vertices.rows()) + " vertices; the template has " +
+                            std::to_string(template_vertices));
   }
+  if (head_space) {
+    const Eigen::Matrix3f r = head_to_world.R.cast<float>();
+    const Eigen::RowVector3f t = head_to_world.t.cast<float>().transpose();
+    frame.world_vertices = ((frame.world_vertices * r.transpose()).rowwise() + t).eval();
+  }
+  frame.head_to_world = head_to_world;
+  return frame;
+}
+
+std::vector<RenderFrame> mesh_sequence(const fs::path& directory, int template_vertices,
+                                       const RigidTransform& head_to_world, bool head_space) {
+  std::vector<RenderFrame> frames;
+  for (const auto& file : mesh_files(directory))
+    frames.push_back(mesh_frame(file, template_vertices, head_to_world, head_space));
   return frames;
 }
 

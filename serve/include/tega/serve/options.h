@@ -30,6 +30,11 @@ struct Options {
   double pose_wait_seconds = 20;
   // Threads answering requests.
   int threads = 8;
+  // Directories of tracked meshes (template topology, world space; `tega track`'s TRACKED/<take>,
+  // held-out takes, new performances) that every run plays as takes of their own, named after the
+  // directory, frames "<take>.<file stem>", each in the head pose of the run's first training frame
+  // as `tega render --meshes` poses them.
+  std::vector<std::filesystem::path> meshes;
   // SPZ files (`tega export --format spz`) the page may open beside the runs, by file name
   // (?splat=NAME), seen from the first run's cameras.
   std::vector<std::filesystem::path> splats;

@@ -62,6 +62,10 @@ std::vector<RenderFrame> dataset_frames(const Dataset& dataset, const std::vecto
 // wrong vertex count or an empty directory.
 std::vector<RenderFrame> mesh_sequence(const std::filesystem::path& directory, int template_vertices,
                                        const RigidTransform& head_to_world, bool head_space);
+// The files mesh_sequence() reads, in its order; and one of them as its frame.
+std::vector<std::filesystem::path> mesh_files(const std::filesystem::path& directory);
+RenderFrame mesh_frame(const std::filesystem::path& file, int template_vertices, const RigidTransform& head_to_world,
+                       bool head_space);
 
 struct RenderJob {
   std::vector<RenderCamera> cameras;
