@@ -44,6 +44,7 @@ ExpressionNetworkImpl::ExpressionNetworkImpl(const NetworkOptions& options) : op
     mlp.precision = MlpPrecision::kBFloat16;
   else
     throw Error(source + ": mlp_precision must be float32 or bfloat16, not '" + options.mlp_precision + "'");
+  mlp.fused = options.mlp_fused;
   mlp.condition_channels = condition_channels;
   mlp.hidden = options.mlp_hidden;
   mlp.encoding.frequencies = options.pe_frequencies;

@@ -2,6 +2,8 @@
 
 #include "tega/nn/silu_tangents.h"
 
+#include "fused_field_mlp.h"
+
 #include <ATen/ATen.h>
 #include <ATen/core/grad_mode.h>
 
@@ -81,6 +83,24 @@ std::pair<at::Tensor, at::Tensor> FieldMLPImpl::output_layer(at::ScalarType type
           at::constant_pad_nd(output_->bias.to(type), {0, padding})};
 }
 
+bool FieldMLPImpl::runs_fused(const EncodedPositions& encoded) const {
+  return options_.fused && options_.precision == MlpPrecision::kBFloat16 &&
+         fused_field::supports(options_, encoded, input_->weight);
+}
+
+FieldWithJacobian FieldMLPImpl::fused_forward(const EncodedPositions& encoded, const at::Tensor& condition) const {
+  if (options_.condition_channels == 0) {
+    TORCH_CHECK(!condition.defined(), "this FieldMLP takes no condition");
+  } else {
+    TORCH_CHECK(condition.defined() && condition.dim() == 2 && condition.size(0) == encoded.encoding.size(0) &&
+                    condition.size(1) == options_.condition_channels,
+                "condition must be [N,", options_.condition_channels, "] for ", encoded.encoding.size(0), " points");
+  }
+  return fused_field::evaluate(
+      options_, {input_->weight, input_->bias, hidden_->weight, hidden_->bias, output_->weight, output_->bias},
+      encoded, condition);
+}
+
 at::Tensor FieldMLPImpl::forward(const at::Tensor& uvd, const at::Tensor& condition) {
   return forward(encode(uvd, /*with_derivatives=*/false), condition);
 }
@@ -91,6 +111,7 @@ FieldWithJacobian FieldMLPImpl::forward_with_jacobian(const at::Tensor& uvd, con
 
 at::Tensor FieldMLPImpl::forward(const EncodedPositions& encoded, const at::Tensor& condition) {
   check_encoded(encoded, /*with_derivatives=*/false);
+  if (runs_fused(encoded)) return fused_forward({encoded.encoding, at::Tensor()}, condition).value;
   const at::ScalarType type = encoded.encoding.scalar_type();
   at::Tensor h = at::silu(first_layer(encoded, condition, input_->weight.to(type)));
   h = at::silu(at::linear(h, hidden_->weight.to(type), hidden_->bias.to(type)));
@@ -109,6 +130,7 @@ FieldWithJacobian FieldMLPImpl::forward_with_jacobian(const EncodedPositions& en
   // plain products, not one batched one: cuBLAS computes the weight gradient
   // of a batched product with K = N as a slow batched GEMV (130 ms at 4M).
   check_encoded(encoded, /*with_derivatives=*/true);
+  if (runs_fused(encoded)) return fused_forward(encoded, condition);
   const at::ScalarType type = encoded.encoding.scalar_type();
   const int64_t n = encoded.encoding.size(0), hidden = options_.hidden, features = options_.encoding.features();
   const at::Tensor input_weight = input_->weight.to(type), hidden_weight = hidden_->weight.to(type);

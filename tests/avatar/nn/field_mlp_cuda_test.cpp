@@ -82,5 +82,76 @@ TEST(FieldMLPCuda, Bfloat16LayersMatchFloat64OnTheCpu) {
   }
 }
 
+// The fused kernels against the composed bfloat16 path (cuBLAS products and
+// SiLU kernels) on the same GPU, for the deformation field's shape, the
+// shading field's (one output, no Jacobian) and a field without a condition,
+// on a point count that leaves a partial tile.
+struct FusedCase {
+  const char* name;
+  int64_t condition_channels, outputs;
+  bool jacobian;
+};
+
+TEST(FieldMLPCuda, FusedKernelsMatchTheComposedPath) {
+  if (!torch::cuda::is_available()) GTEST_SKIP() << "no CUDA device";
+  const at::TensorOptions cuda = at::TensorOptions().device(at::kCUDA, 0).dtype(at::kFloat);
+  for (const FusedCase& c : {FusedCase{"deformation", 64, 3, true}, FusedCase{"shading", 64, 1, false},
+                             FusedCase{"unconditioned", 0, 3, true}}) {
+    SCOPED_TRACE(c.name);
+    FieldMLPOptions options;
+    options.condition_channels = c.condition_channels;
+    options.outputs = c.outputs;
+    FieldMLP fused(options);
+    options.fused = false;
+    FieldMLP composed(options);
+    {
+      at::NoGradGuard no_grad;
+      fused->named_parameters()["output.weight"].normal_(0.0, 0.3);
+      fused->named_parameters()["output.bias"].normal_(0.0, 0.3);
+      const auto source = fused->parameters(), target = composed->parameters();
+      for (size_t i = 0; i < source.size(); ++i) target[i].copy_(source[i]);
+    }
+    fused->to(at::Device(at::kCUDA, 0));
+    composed->to(at::Device(at::kCUDA, 0));
+
+    const int64_t n = 50021;
+    at::Tensor uvd_in = at::rand({n, 3}, cuda);
+    uvd_in.select(1, 2).mul_(0.25).sub_(0.05);
+    const at::Tensor condition_in =
+        c.condition_channels ? at::randn({n, c.condition_channels}, cuda) : at::Tensor();
+    const at::Tensor value_weight = at::randn({n, c.outputs}, cuda), jacobian_weight = at::randn({n, c.outputs, 3}, cuda);
+
+    const auto run = [&](FieldMLP& mlp, bool expect_fused) {
+      const at::Tensor uvd = uvd_in.clone().requires_grad_(true);
+      const at::Tensor condition = condition_in.defined() ? condition_in.clone().requires_grad_(true) : at::Tensor();
+      const EncodedPositions encoded = mlp->encode(uvd, c.jacobian);
+      EXPECT_EQ(mlp->runs_fused(encoded), expect_fused);
+      at::Tensor loss;
+      std::vector<at::Tensor> outputs;
+      if (c.jacobian) {
+        const FieldWithJacobian out = mlp->forward_with_jacobian(encoded, condition);
+        loss = (out.value * value_weight).sum() + (out.jacobian * jacobian_weight).sum();
+        outputs = {out.value.detach(), out.jacobian.detach()};
+      } else {
+        const at::Tensor value = mlp->forward(encoded, condition);
+        loss = (value * value_weight).sum();
+        outputs = {value.detach()};
+      }
+      std::vector<at::Tensor> inputs = mlp->parameters();
+      inputs.push_back(uvd);
+      if (condition.defined()) inputs.push_back(condition);
+      for (const at::Tensor& g : torch::autograd::grad({loss}, inputs)) outputs.push_back(g);
+      return outputs;
+    };
+    const std::vector<at::Tensor> expected = run(composed, false), actual = run(fused, true);
+    ASSERT_EQ(actual.size(), expected.size());
+    for (size_t i = 0; i < actual.size(); ++i) {
+      EXPECT_EQ(actual[i].scalar_type(), at::kFloat) << "output " << i;
+      EXPECT_TRUE(actual[i].isfinite().all().item<bool>()) << "output " << i;
+      EXPECT_LE(relative_error(actual[i], expected[i]), 2e-2) << "output " << i;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace tega::nn

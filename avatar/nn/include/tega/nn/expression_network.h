@@ -38,6 +38,7 @@ struct NetworkOptions {
   int pe_frequencies = 6;
   double pe_depth_scale = 3.0;
   std::string mlp_precision = "bfloat16";
+  bool mlp_fused = true;
 
   template <class V>
   void visit(V& v) {
@@ -54,6 +55,10 @@ struct NetworkOptions {
       "What the deformation and shading MLPs' layers compute in on CUDA: float32, or bfloat16 (GEMM inputs, "
       "activations and Jacobian tangents; weights, encoding and outputs stay float32). On the CPU they always run "
       "in float32.");
+    v("mlp_fused", mlp_fused,
+      "With bfloat16 on a GPU with bfloat16 tensor cores (compute capability 8.0+) and mlp_hidden 64, run each MLP "
+      "as two fused kernels (forward with its Jacobian, and backward) instead of cuBLAS products and separate "
+      "activation kernels; false keeps the composed path.");
   }
 };
 

@@ -13,9 +13,10 @@
 // tangent columns travel through the layers next to the activations
 // (J ← J·Wᵀ for a linear layer, J ← σ'(pre-activation)·J for the activation)
 // starting from the positional encoding's analytic derivative. The latent is
-// a condition: it is not differentiated w.r.t. uvd. All of it is plain tensor
-// algebra, so autograd differentiates the Jacobian too (the smoothness loss
-// and the covariance J Σ Jᵀ train the weights through it).
+// a condition: it is not differentiated w.r.t. uvd. Autograd differentiates
+// the Jacobian too (the smoothness loss and the covariance J Σ Jᵀ train the
+// weights through it): through plain tensor algebra, or on CUDA through two
+// fused kernels that compute the same (FieldMLPOptions::fused).
 //
 // SiLU rather than ReLU because J enters the Gaussians' covariances: with a
 // smooth activation the Jacobian is continuous in uvd and its gradient w.r.t.
@@ -50,6 +51,11 @@ struct FieldMLPOptions {
   int64_t outputs = 3;
   PositionalEncoding encoding;
   MlpPrecision precision = MlpPrecision::kBFloat16;
+  // With bfloat16 on a GPU that has bfloat16 tensor cores, run the field as
+  // two fused kernels (src/fused_field_mlp.h) when they take its widths
+  // (64 hidden, ≤ 8 outputs); false keeps the composed cuBLAS path, the
+  // reference the kernels are tested against.
+  bool fused = true;
 };
 
 struct FieldWithJacobian {
@@ -75,6 +81,8 @@ class FieldMLPImpl : public torch::nn::Module {
   FieldWithJacobian forward_with_jacobian(const at::Tensor& uvd, const at::Tensor& condition);
 
   const FieldMLPOptions& options() const { return options_; }
+  // Whether these inputs run through the fused kernels (FieldMLPOptions::fused).
+  bool runs_fused(const EncodedPositions& encoded) const;
 
  private:
   at::ScalarType layer_type(const at::Tensor& uvd) const;
@@ -84,6 +92,7 @@ class FieldMLPImpl : public torch::nn::Module {
   // The output layer's weight and bias in the layers' type, rows padded to
   // an aligned count (positional_encoding.h says why).
   std::pair<at::Tensor, at::Tensor> output_layer(at::ScalarType type) const;
+  FieldWithJacobian fused_forward(const EncodedPositions& encoded, const at::Tensor& condition) const;
 
   FieldMLPOptions options_;
   torch::nn::Linear input_{nullptr}, hidden_{nullptr}, output_{nullptr};
