@@ -345,8 +345,8 @@ __device__ __forceinline__ void for_tile(const C& c, int64_t r0, int column0, La
 
 // --- forward -----------------------------------------------------------------
 
-__global__ void __launch_bounds__(kThreads) forward_kernel(Shape s, Layout lay, Weights w, Inputs in,
-                                                           float* __restrict__ value, float* __restrict__ jacobian) {
+__global__ void __launch_bounds__(kThreads) fused_field_forward(Shape s, Layout lay, Weights w, Inputs in,
+                                                                float* __restrict__ value, float* __restrict__ jacobian) {
   extern __shared__ uint4 shared_memory[];
   const Shared sh = shared_weights(reinterpret_cast<char*>(shared_memory), lay);
   load_weights(s, lay, w, sh);
@@ -447,9 +447,9 @@ __device__ void hidden_backward(C (&out)[kHiddenBlocks], const A (&g)[kHiddenSte
 // its pre-activations' gradients) is written out in bfloat16 for the matrix
 // products that sum them over the points (fused_field_mlp.cpp).
 __global__ void __launch_bounds__(kThreads)
-    backward_kernel(Shape s, Layout lay, Weights w, Inputs in, const float* __restrict__ grad_value,
-                    const float* __restrict__ grad_jacobian, __nv_bfloat16* __restrict__ grad_encoding,
-                    __nv_bfloat16* __restrict__ grad_derivatives, float* __restrict__ grad_condition, Products p) {
+    fused_field_backward(Shape s, Layout lay, Weights w, Inputs in, const float* __restrict__ grad_value,
+                         const float* __restrict__ grad_jacobian, __nv_bfloat16* __restrict__ grad_encoding,
+                         __nv_bfloat16* __restrict__ grad_derivatives, float* __restrict__ grad_condition, Products p) {
   extern __shared__ uint4 shared_memory[];
   const Shared sh = shared_weights(reinterpret_cast<char*>(shared_memory), lay);
   load_weights(s, lay, w, sh);
@@ -594,11 +594,11 @@ void forward(const Shape& shape, const Weights& weights, const Inputs& inputs, f
              int multiprocessors, cudaStream_t stream) {
   if (shape.points == 0) return;
   const Layout lay = layout_of(shape);
-  check_cuda(cudaFuncSetAttribute(forward_kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, int(lay.scratch)),
+  check_cuda(cudaFuncSetAttribute(fused_field_forward, cudaFuncAttributeMaxDynamicSharedMemorySize, int(lay.scratch)),
              "fused_field_mlp", "setting the forward kernel's shared memory");
-  forward_kernel<<<blocks_for(shape, multiprocessors), kThreads, lay.scratch, stream>>>(shape, lay, weights, inputs,
-                                                                                        value, jacobian);
-  check_launch("fused_field_mlp", "forward_kernel");
+  fused_field_forward<<<blocks_for(shape, multiprocessors), kThreads, lay.scratch, stream>>>(shape, lay, weights,
+                                                                                             inputs, value, jacobian);
+  check_launch("fused_field_mlp", "fused_field_forward");
 }
 
 void backward(const Shape& shape, const Weights& weights, const Inputs& inputs, const float* grad_value,
@@ -606,12 +606,12 @@ void backward(const Shape& shape, const Weights& weights, const Inputs& inputs, 
               float* grad_condition, const Products& products, int multiprocessors, cudaStream_t stream) {
   if (shape.points == 0) return;
   const Layout lay = layout_of(shape);
-  check_cuda(cudaFuncSetAttribute(backward_kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, int(lay.end)),
+  check_cuda(cudaFuncSetAttribute(fused_field_backward, cudaFuncAttributeMaxDynamicSharedMemorySize, int(lay.end)),
              "fused_field_mlp", "setting the backward kernel's shared memory");
-  backward_kernel<<<blocks_for(shape, multiprocessors), kThreads, lay.end, stream>>>(
+  fused_field_backward<<<blocks_for(shape, multiprocessors), kThreads, lay.end, stream>>>(
       shape, lay, weights, inputs, grad_value, grad_jacobian, grad_encoding, grad_derivatives, grad_condition,
       products);
-  check_launch("fused_field_mlp", "backward_kernel");
+  check_launch("fused_field_mlp", "fused_field_backward");
 }
 
 }  // namespace tega::nn::fused_field::cuda
