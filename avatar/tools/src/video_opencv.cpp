@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <opencv2/core.hpp>
 #include <opencv2/videoio.hpp>
+#include <opencv2/videoio/registry.hpp>
 
 #include "tega/core/error.h"
 #include "tega/core/files.h"
@@ -9,9 +10,18 @@
 
 namespace tega::tools {
 
-bool video_supported() { return true; }
+// mp4v in an MP4 container is FFmpeg's (or GStreamer's) to write. An OpenCV
+// built without them (the one scripts/gpu-carry builds) still lists them
+// among its writer backends, as plugins it cannot load: hasBackend asks.
+bool video_supported() {
+  return cv::videoio_registry::hasBackend(cv::CAP_FFMPEG) || cv::videoio_registry::hasBackend(cv::CAP_GSTREAMER);
+}
 
-std::string video_unsupported_reason() { return {}; }
+std::string video_unsupported_reason() {
+  return video_supported() ? std::string()
+                           : "this OpenCV was built without FFmpeg or GStreamer, so no MP4 is written; the frames are "
+                             "there as images";
+}
 
 namespace {
 

@@ -1,6 +1,6 @@
 #pragma once
 // MP4 output of `tega render`, through OpenCV's VideoWriter (codec mp4v)
-// where the build has OpenCV (TEGA_HAVE_OPENCV); the GPU machine has none.
+// where the build has OpenCV (TEGA_HAVE_OPENCV) with FFmpeg or GStreamer.
 
 #include <filesystem>
 #include <string>
