@@ -134,7 +134,8 @@ void add_run_command(CLI::App& app) {
       ->check(CLI::IsMember({"local", "slurm"}))
       ->default_str("local");
   cmd->add_option("--partition", args->slurm.partition, "Slurm partition for the jobs (default: the cluster's).");
-  cmd->add_option("--gpus-per-job", args->slurm.gpus_per_job, "GPUs a Slurm job of a GPU stage asks for (--gres=gpu:N).")
+  cmd->add_option("--gpus-per-job", args->slurm.gpus_per_job,
+                  "GPUs a Slurm job of a GPU stage asks for (--gres=gpu:N; a train stage's gpus_per_job when larger).")
       ->capture_default_str();
   cmd->add_option("--max-requeues", args->slurm.max_requeues,
                   "How often a Slurm job lost to the cluster (node failure, preemption, killed) is submitted again.")

@@ -89,8 +89,13 @@ void add_train_command(CLI::App& app) {
     if (args->data.empty() || args->out.empty()) throw Error("tega train needs --data and --out");
     if (args->gpus || args->processes > 1) {
       if (args->gpus && args->processes > 0) throw Error("tega train: --gpus or --processes, not both");
-      const std::vector<std::string> gpus = args->gpus ? pipeline::parse_gpu_list(*args->gpus, "--gpus")
-                                                       : std::vector<std::string>{};
+      std::vector<std::string> gpus = args->gpus ? pipeline::parse_gpu_list(*args->gpus, "--gpus")
+                                                 : std::vector<std::string>{};
+      // Numbered as this process sees them: a `tega run` shard or Slurm job is pinned to its own.
+      const char* visible = std::getenv("CUDA_VISIBLE_DEVICES");
+      for (std::string& gpu : gpus)
+        gpu = pipeline::child_visible_device(gpu, visible ? std::optional<std::string>(visible) : std::nullopt,
+                                             "tega train --gpus");
       if (args->gpus && options.device.rfind("cuda", 0) != 0)
         throw Error("tega train: --gpus trains on GPUs: pass --device cuda (or --processes N for the CPU)");
       if (!args->gpus && options.device != "cpu")

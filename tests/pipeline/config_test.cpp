@@ -64,6 +64,17 @@ TEST(PipelineConfig, AStageMaySplitItsShardsIntoJobsOfSomeFrames) {
             std::string::npos);
 }
 
+TEST(PipelineConfig, ATrainStageMayTakeSeveralGpusAJob) {
+  const auto c = parse("workspace: ws\nstages:\n  train: {gpus_per_job: 4}\n  eval:\n");
+  EXPECT_EQ(c.stages[0].gpus_per_job, 4);
+  EXPECT_EQ(c.stages[1].gpus_per_job, 1);
+  for (const char* bad : {"0", "-2", "two"})
+    EXPECT_NE(error_of([&] { parse(std::string("workspace: ws\nstages:\n  train: {gpus_per_job: ") + bad + "}\n"); })
+                  .find("stages.train.gpus_per_job must be a whole number of GPUs, at least 1"),
+              std::string::npos)
+        << bad;
+}
+
 TEST(PipelineConfig, OptionsAreCanonicalWhateverTheirOrderAndLayout) {
   const auto a = parse("workspace: ws\nstages:\n  synth:\n    options:\n      seed: 1\n      studio: {width: 64, cameras: 2}\n");
   const auto b = parse("workspace: ws\nstages:\n  synth: {options: {studio: {cameras: 2, width: 64}, seed: 1}}\n");
@@ -116,7 +127,7 @@ TEST(PipelineConfig, UnknownKeysAreErrorsNamingTheFileAndTheKnownKeys) {
             "/cfg/p.yaml: unknown key 'stage' (line 2); known keys: description, workspace, subjects, stages, gpus");
   EXPECT_EQ(error_of([] { parse("workspace: ws\nstages:\n  synth: {option: {}}\n"); }),
             "/cfg/p.yaml: unknown key 'stages.synth.option' (line 3); known keys of 'stages.synth': kind, after, "
-            "options, options_file, frames_per_job");
+            "options, options_file, frames_per_job, gpus_per_job");
   EXPECT_NE(error_of([] { parse("workspace: ws\nsubjects: {a: {options: {trian: {}}}}\nstages: {train: }\n"); })
                 .find("'subjects.a.options.trian' names no stage"),
             std::string::npos);

@@ -118,6 +118,38 @@ TEST(LocalExecutor, SpreadsCudaJobsOverItsGpusEachPinnedToOneOfThem) {
   }
 }
 
+TEST(LocalExecutor, AJobOfSeveralGpusWaitsForThatManyFreeOnesAndIsPinnedToAllOfThem) {
+  test::TempDir dir;
+  const ScopedEnvironment machine("CUDA_VISIBLE_DEVICES", "0,1,2");
+  LocalExecutor executor(1, {"0", "1", "2"});
+  const auto on_gpus = [&](const std::string& id, int count, const std::string& script) {
+    Job job = shell_job(id, script, dir, "cuda");
+    job.resources.gpu_count = count;
+    return job;
+  };
+  // one (1 GPU) and pair (2 GPUs) only succeed together: on three GPUs at once. Then second_pair
+  // must wait until two are free, holding its lock alone.
+  executor.submit(on_gpus("one", 1, record_gpu("one", rendezvous("one.started", "pair.started"))));
+  executor.submit(on_gpus("pair", 2, record_gpu("pair", rendezvous("pair.started", "one.started"))));
+  executor.submit(on_gpus("second_pair", 2, record_gpu("second_pair")));
+  executor.submit(on_gpus("too_many", 4, "true"));
+  const auto results = wait_for_all(executor, 30s);
+  ASSERT_EQ(results.size(), 4u);
+  for (const auto& r : results) {
+    if (r.id == "too_many") {
+      EXPECT_FALSE(r.succeeded);
+      EXPECT_NE(r.failure.find("needs 4 GPUs at once and this run has 3"), std::string::npos) << r.failure;
+    } else {
+      EXPECT_TRUE(r.succeeded) << r.id << ": " << r.failure;
+    }
+  }
+  const std::string one = gpu_seen(dir, "one"), pair = gpu_seen(dir, "pair");
+  EXPECT_EQ(pair.size(), 3u) << pair;  // two of the three, e.g. "0,1"
+  EXPECT_EQ(pair.find(one), std::string::npos) << one << " is also in " << pair;
+  EXPECT_EQ(gpu_seen(dir, "second_pair").size(), 3u);
+  EXPECT_NE(read_text_file(dir / "logs/pair.log").find(" on GPUs " + pair + ":"), std::string::npos);
+}
+
 TEST(LocalExecutor, WithoutGpusRunsCudaJobsOneAtATimeUnpinned) {
   test::TempDir dir;
   const ScopedEnvironment machine("CUDA_VISIBLE_DEVICES", "5,6");

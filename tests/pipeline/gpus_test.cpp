@@ -37,5 +37,20 @@ TEST(Gpus, TheMachinesAreThoseCudaVisibleDevicesLeavesElseTheDriversElseNone) {
   EXPECT_EQ(machine_gpus(std::nullopt, driver / "absent"), Gpus{});
 }
 
+TEST(Gpus, AChildIsPinnedToTheGpuThisProcessNumbersSo) {
+  EXPECT_EQ(child_visible_device("1", std::string("4,6,7"), "--gpus"), "6");  // this process's device 1
+  EXPECT_EQ(child_visible_device("0", std::string("GPU-8a1c,GPU-22"), "--gpus"), "GPU-8a1c");
+  EXPECT_EQ(child_visible_device("GPU-22", std::string("GPU-8a1c,GPU-22"), "--gpus"), "GPU-22");
+  EXPECT_EQ(child_visible_device("3", std::nullopt, "--gpus"), "3");  // nothing hidden: the machine's 3
+  try {
+    child_visible_device("2", std::string("4,6"), "tega train --gpus");
+    ADD_FAILURE() << "device 2 of two was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("tega train --gpus: GPU 2"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("CUDA_VISIBLE_DEVICES=4,6"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(child_visible_device("0", std::string(""), "--gpus"), Error);  // every GPU hidden
+}
+
 }  // namespace
 }  // namespace tega::pipeline

@@ -357,6 +357,34 @@ TEST(TegaRun, OnlyStagesThatSplitTakeFramesPerJob) {
       << r.output;
 }
 
+// No GPU needed: the train shard's log header shows the GPUs it was pinned to and the flag that
+// spreads training over them, before tega train finds that CUDA is not there.
+TEST(TegaRun, ATrainShardOfSeveralGpusIsPinnedToThatManyAndTrainsOnAllOfThem) {
+  REQUIRE_SYNTH();
+  TempDir dir;
+  const std::string stages = "workspace: ws\nstages:\n  synth:\n    options:\n" + tiny_synth_options(6) +
+                             "  train:\n    after: synth\n    gpus_per_job: 2\n    options: {iterations: 2, device: ";
+  write_text(dir / "cuda.yaml", stages + "cuda}\n");
+  const auto r = run_tega({"run", (dir / "cuda.yaml").string(), "--gpus", "3,1,2"}, dir.path());
+  EXPECT_NE(r.output.find("train/default started on 2 GPUs"), std::string::npos) << r.output;
+  const std::string log = read_text_file(dir / "ws/logs/train/default.log");
+  EXPECT_NE(log.find("train/default on GPUs 3,1: "), std::string::npos) << log;
+  EXPECT_NE(log.find(" --gpus 0,1"), std::string::npos) << log;
+
+  write_text(dir / "cpu.yaml", stages + "cpu}\n");
+  const auto cpu = run_tega({"run", (dir / "cpu.yaml").string(), "--workspace", (dir / "cpu").string()}, dir.path());
+  EXPECT_NE(cpu.exit_code, 0);
+  EXPECT_NE(cpu.output.find("gpus_per_job: 2 needs the option device: cuda (it is cpu)"), std::string::npos)
+      << cpu.output;
+
+  write_text(dir / "check.yaml", "workspace: ws\nstages:\n  synth:\n  check: {kind: dataset_check, after: synth, "
+                                 "gpus_per_job: 2}\n");
+  const auto check = run_tega({"run", (dir / "check.yaml").string()}, dir.path());
+  EXPECT_NE(check.exit_code, 0);
+  EXPECT_NE(check.output.find("stage 'check': gpus_per_job: a dataset_check shard runs on one GPU"), std::string::npos)
+      << check.output;
+}
+
 TEST(TegaRun, ABadGpuListIsAnErrorBeforeAnythingRuns) {
   TempDir dir;
   write_text(dir / "p.yaml", "workspace: ws\nstages:\n  check: {kind: dataset_check}\n");

@@ -135,14 +135,20 @@ StageConfig read_stage(const Reader& r, const std::string& name, const YAML::Nod
   stage.kind = name;
   if (node.IsNull()) return stage;
   r.require_map(node, where);
-  r.check_keys(node, where, {"kind", "after", "options", "options_file", "frames_per_job"});
+  r.check_keys(node, where, {"kind", "after", "options", "options_file", "frames_per_job", "gpus_per_job"});
   if (node["kind"]) stage.kind = r.scalar(node["kind"], where + ".kind");
-  if (node["frames_per_job"]) {
-    const std::string text = r.scalar(node["frames_per_job"], where + ".frames_per_job");
-    if (text.empty() || text.size() > 9 || text.find_first_not_of("0123456789") != std::string::npos)
-      r.fail(node["frames_per_job"], where + ".frames_per_job must be a whole number of frames, 0 for one job");
-    stage.frames_per_job = std::stoi(text);
-  }
+  // A whole number of at least `least`; else an error saying what the key must be.
+  const auto whole_number = [&](const char* key, int least, const std::string& meaning) {
+    const std::string text = r.scalar(node[key], where + "." + key);
+    if (text.empty() || text.size() > 9 || text.find_first_not_of("0123456789") != std::string::npos ||
+        std::stoi(text) < least)
+      r.fail(node[key], where + "." + key + " must be " + meaning);
+    return std::stoi(text);
+  };
+  if (node["frames_per_job"])
+    stage.frames_per_job = whole_number("frames_per_job", 0, "a whole number of frames, 0 for one job");
+  if (node["gpus_per_job"])
+    stage.gpus_per_job = whole_number("gpus_per_job", 1, "a whole number of GPUs, at least 1");
   if (node["after"]) stage.after = r.string_list(node["after"], where + ".after");
   YAML::Node options;
   if (node["options_file"]) {

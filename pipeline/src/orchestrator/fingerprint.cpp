@@ -59,6 +59,8 @@ Fingerprint fingerprint_shard(const StageGraph& graph, size_t stage_index, size_
   for (size_t in : stage.inputs) {
     fp.inputs.emplace_back(graph.stages()[in].name() + "/" + subject.name, output_hash_of(in, subject_index));
   }
+  // More GPUs a step are more views a step: another training.
+  if (stage.config->gpus_per_job > 1) fp.inputs.emplace_back("gpus_per_job", std::to_string(stage.config->gpus_per_job));
   if (stage.kind->reads_capture) {
     if (subject.capture.empty()) {
       throw Error(config.source, "stage '" + stage.name() + "' (kind " + stage.kind->name + ") reads a capture: subject '" +

@@ -39,6 +39,17 @@ std::vector<std::string> machine_gpus(const std::optional<std::string>& cuda_vis
   return gpus;
 }
 
+std::string child_visible_device(const std::string& gpu, const std::optional<std::string>& cuda_visible_devices,
+                                 const std::string& what) {
+  if (!cuda_visible_devices || gpu.find_first_not_of("0123456789") != std::string::npos || gpu.size() > 9) return gpu;
+  const std::vector<std::string> visible = parse_gpu_list(*cuda_visible_devices, "CUDA_VISIBLE_DEVICES");
+  const size_t index = std::stoul(gpu);
+  if (index >= visible.size())
+    throw Error(what + ": GPU " + gpu + " is not among this process's " + std::to_string(visible.size()) +
+                " (CUDA_VISIBLE_DEVICES=" + *cuda_visible_devices + " numbers them from 0)");
+  return visible[index];
+}
+
 std::vector<std::string> machine_gpus() {
   const char* visible = std::getenv("CUDA_VISIBLE_DEVICES");
   return machine_gpus(visible ? std::optional<std::string>(visible) : std::nullopt);

@@ -82,18 +82,19 @@ LocalExecutor::~LocalExecutor() { cancel_all(); }
 
 void LocalExecutor::submit(Job job) { queue_.push_back(std::move(job)); }
 
-pid_t LocalExecutor::launch(const Job& job, const std::string& pinned_gpu) {
+pid_t LocalExecutor::launch(const Job& job, const std::string& pinned) {
   fs::create_directories(job.log_file.parent_path());
   const int log_fd = ::open(job.log_file.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   if (log_fd < 0) throw Error(job.log_file, "cannot be opened for writing");
-  std::string header = "=== " + utc_now() + " " + job.id + (pinned_gpu.empty() ? "" : " on GPU " + pinned_gpu) + ":";
+  const std::string on = pinned.empty() ? "" : (pinned.find(',') == std::string::npos ? " on GPU " : " on GPUs ") + pinned;
+  std::string header = "=== " + utc_now() + " " + job.id + on + ":";
   for (const auto& a : job.argv) header += " " + a;
   header += "\n";
   (void)!::write(log_fd, header.data(), header.size());
 
   // Built before fork: between fork and exec nothing may allocate.
   std::vector<char*> argv = null_terminated(job.argv);
-  const std::vector<std::string> environment = child_environment(pinned_gpu);
+  const std::vector<std::string> environment = child_environment(pinned);
   std::vector<char*> envp = null_terminated(environment);
   const std::string directory = job.working_directory.string();
   const pid_t parent = ::getpid();
@@ -105,35 +106,52 @@ pid_t LocalExecutor::launch(const Job& job, const std::string& pinned_gpu) {
   return pid;
 }
 
-std::optional<std::pair<std::string, bool>> LocalExecutor::free_gpu(const Job& job) const {
+std::optional<LocalExecutor::Held> LocalExecutor::free_gpus(const Job& job) const {
   const auto held = [&](const std::string& gpu) {
-    return std::any_of(running_.begin(), running_.end(), [&](const auto& r) { return r.second.gpu == gpu; });
+    return std::any_of(running_.begin(), running_.end(), [&](const auto& r) {
+      const auto& gpus = r.second.held.gpus;
+      return std::find(gpus.begin(), gpus.end(), gpu) != gpus.end();
+    });
   };
   const std::string& device = job.resources.gpu_device;
   if (device == "cuda" && !gpus_.empty()) {
+    const size_t wanted = size_t(std::max(1, job.resources.gpu_count));
+    Held free{{}, true};
     for (const std::string& gpu : gpus_)
-      if (!held(gpu)) return std::make_pair(gpu, true);
-    return std::nullopt;
+      if (!held(gpu) && free.gpus.size() < wanted) free.gpus.push_back(gpu);
+    if (free.gpus.size() < wanted) return std::nullopt;
+    return free;
   }
   const std::string gpu = device.rfind("cuda:", 0) == 0 ? device.substr(5) : device;
   if (held(gpu)) return std::nullopt;
-  return std::make_pair(gpu, false);
+  return Held{{gpu}, false};
 }
 
 void LocalExecutor::start_ready_jobs(std::vector<JobResult>& results) {
   int cpu_running = 0;
-  for (const auto& [pid, r] : running_) cpu_running += r.gpu.empty() ? 1 : 0;
+  for (const auto& [pid, r] : running_) cpu_running += r.held.gpus.empty() ? 1 : 0;
   for (auto it = queue_.begin(); it != queue_.end();) {
     const bool cpu_job = it->resources.gpu_device.empty();
-    std::optional<std::pair<std::string, bool>> gpu;
-    if (cpu_job ? cpu_running >= cpu_slots_ : !(gpu = free_gpu(*it))) {
+    if (!cpu_job && !gpus_.empty() && it->resources.gpu_count > int(gpus_.size())) {
+      results.push_back({it->id, false,
+                         "could not start: it needs " + std::to_string(it->resources.gpu_count) +
+                             " GPUs at once and this run has " + std::to_string(gpus_.size()) + " (tega run --gpus)",
+                         0});
+      it = queue_.erase(it);
+      continue;
+    }
+    std::optional<Held> gpus;
+    if (cpu_job ? cpu_running >= cpu_slots_ : !(gpus = free_gpus(*it))) {
       ++it;
       continue;
     }
     try {
-      const auto& [held, pinned] = cpu_job ? std::make_pair(std::string(), false) : *gpu;
-      const pid_t pid = launch(*it, pinned ? held : "");
-      running_[pid] = {std::move(*it), held, pinned, Clock::now()};
+      const Held held = cpu_job ? Held{} : *gpus;
+      std::string pinned;
+      if (held.pinned)
+        for (const std::string& gpu : held.gpus) pinned += (pinned.empty() ? "" : ",") + gpu;
+      const pid_t pid = launch(*it, pinned);
+      running_[pid] = {std::move(*it), held, Clock::now()};
       cpu_running += cpu_job ? 1 : 0;
     } catch (const std::exception& e) {
       results.push_back({it->id, false, std::string("could not start: ") + e.what(), 0});

@@ -210,9 +210,19 @@ class Run {
     job.argv.insert(job.argv.end(), arguments.begin(), arguments.end());
     job.working_directory = config_.base_dir;
     job.log_file = ws_.log_file(stage.name(), subject.name);
+    std::optional<std::string> device;
     if (!stage.kind->device_option.empty()) {
-      const auto device = scalar_option(s.fingerprint.options_yaml, stage.kind->device_option);
+      device = scalar_option(s.fingerprint.options_yaml, stage.kind->device_option);
       if (device && device->rfind("cuda", 0) == 0) job.resources.gpu_device = *device;
+    }
+    if (const int gpus = stage.config->gpus_per_job; gpus > 1) {
+      if (job.resources.gpu_device != "cuda")
+        throw Error("gpus_per_job: " + std::to_string(gpus) + " needs the option " + stage.kind->device_option +
+                    ": cuda (it is " + (device ? *device : "unset") + "), so that tega run chooses the GPUs");
+      job.resources.gpu_count = gpus;
+      std::string visible = "0";  // the job sees its GPUs as its devices 0 to N-1
+      for (int g = 1; g < gpus; ++g) visible.append(",").append(std::to_string(g));
+      job.argv.insert(job.argv.end(), {stage.kind->gpus_flag, visible});
     }
     s.command = job.argv;
 
@@ -243,7 +253,9 @@ class Run {
     write_shard_state(ws_.state_file(stage.name(), subject.name), {"running", "", first.log_file.string(), s.started, ""});
     spdlog::info("{} started{}{} (log: {})", s.id,
                  s.jobs.size() > 1 ? " as " + std::to_string(s.jobs.size()) + " jobs" : "",
-                 first.resources.gpu_device.empty() ? "" : " on " + first.resources.gpu_device,
+                 first.resources.gpu_device.empty()   ? ""
+                 : first.resources.gpu_count > 1      ? " on " + std::to_string(first.resources.gpu_count) + " GPUs"
+                                                      : " on " + first.resources.gpu_device,
                  s.jobs.size() > 1 ? ws_.log_file(stage.name(), subject.name + "#*").string() : first.log_file.string());
     s.phase = Phase::queued;
     for (const Job& part : s.jobs) {

@@ -159,7 +159,12 @@ std::string submitted_job_id(const std::vector<std::string>& sbatch_args, const 
 
 std::string stage_of(const Job& job) { return job.id.substr(0, job.id.find('/')); }
 
-bool same_resources(const Resources& a, const Resources& b) { return a.gpu_device == b.gpu_device; }
+bool same_resources(const Resources& a, const Resources& b) {
+  return a.gpu_device == b.gpu_device && a.gpu_count == b.gpu_count;
+}
+
+// A job of several GPUs (a train shard's gpus_per_job) asks for them, at least --gpus-per-job.
+int job_gpus(const Resources& resources, int gpus_per_job) { return std::max(gpus_per_job, resources.gpu_count); }
 
 // Slurm's default MaxArraySize (1001) allows task indices 0 to 1000.
 constexpr size_t kMaxArrayTasks = 1001;
@@ -219,7 +224,7 @@ SlurmExecutor::~SlurmExecutor() {
 void SlurmExecutor::submit(Job job) { queue_.push_back(std::move(job)); }
 
 void SlurmExecutor::prepare(const Job& job) const {
-  check_gpu_device(job, options_.gpus_per_job);
+  check_gpu_device(job, job_gpus(job.resources, options_.gpus_per_job));
   fs::create_directories(job.log_file.parent_path());
   const SlurmJobFiles files = slurm_job_files(job.log_file);
   fs::remove(files.exit_file);
@@ -237,7 +242,8 @@ std::vector<std::string> SlurmExecutor::sbatch_arguments(const std::string& name
                                    "--export=ALL",
                                    "--no-requeue"};  // requeues are ours: the shard is prepared afresh first
   if (!options_.partition.empty()) args.push_back("--partition=" + options_.partition);
-  if (!resources.gpu_device.empty()) args.push_back("--gres=gpu:" + std::to_string(options_.gpus_per_job));
+  if (!resources.gpu_device.empty())
+    args.push_back("--gres=gpu:" + std::to_string(job_gpus(resources, options_.gpus_per_job)));
   return args;
 }
 

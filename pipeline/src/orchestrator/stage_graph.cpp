@@ -62,6 +62,10 @@ StageGraph::StageGraph(PipelineConfig config, const CommandAvailable& available)
       throw Error(source, "stage '" + sc.name + "': frames_per_job: a " + stage.kind->name +
                               " shard runs as one job (only mvs and matte split into jobs)");
     }
+    if (sc.gpus_per_job > 1 && stage.kind->gpus_flag.empty()) {
+      throw Error(source, "stage '" + sc.name + "': gpus_per_job: a " + stage.kind->name +
+                              " shard runs on one GPU (only train spreads a shard over several)");
+    }
     for (const auto& up : sc.after) {
       const auto it = by_name.find(up);
       if (it == by_name.end()) throw Error(source, "stage '" + sc.name + "': 'after' names no stage: '" + up + "'");

@@ -104,6 +104,7 @@ std::vector<StageKind> make_stage_kinds() {
   train.provides = {{"run", "run"}};
   train.path_options = {"loss.vgg_weights"};
   train.device_option = "device";
+  train.gpus_flag = "--gpus";  // data parallel (docs/training.md#on-several-gpus)
   // A shard killed mid-run continues from its last checkpoint.
   train.resumes_in_staging = true;
   train.arguments = [](const ShardPaths& p) {

@@ -20,6 +20,9 @@ struct StageConfig {
   // `frames_per_job: N`: each shard runs as several jobs at once, each on at most N frames of
   // one take (kinds with StageKind::split only); 0: one job a shard.
   int frames_per_job = 0;
+  // `gpus_per_job: N`: each shard runs on N GPUs at once (kinds with StageKind::gpus_flag only:
+  // train, data parallel), with the stage's device `cuda`; 1: one GPU, as any GPU stage.
+  int gpus_per_job = 1;
   // `options_file` (a file in the command's own --config format) with
   // `options` merged over it; canonical YAML, "" = none.
   std::string options_yaml;

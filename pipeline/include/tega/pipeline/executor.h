@@ -17,6 +17,9 @@ struct Resources {
   // chooses (the local one pins the job to it with CUDA_VISIBLE_DEVICES); "cuda:1": that
   // device, as the machine numbers it. A GPU runs one job at a time.
   std::string gpu_device;
+  // GPUs a "cuda" job holds at once (a train shard of `gpus_per_job: N`): the local executor pins
+  // it to that many free GPUs (CUDA_VISIBLE_DEVICES=a,b,...), Slurm asks for them (--gres=gpu:N).
+  int gpu_count = 1;
 };
 
 struct Job {

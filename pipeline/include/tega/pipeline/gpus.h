@@ -22,4 +22,11 @@ std::vector<std::string> machine_gpus(const std::optional<std::string>& cuda_vis
                                       const std::filesystem::path& driver_gpus = "/proc/driver/nvidia/gpus");
 std::vector<std::string> machine_gpus();  // of this process's environment and this machine
 
+// The CUDA_VISIBLE_DEVICES entry that pins a child process to `gpu`, a GPU as this process names
+// it: under CUDA_VISIBLE_DEVICES=a,b,... (a `tega run` shard, a Slurm job) index i is this
+// process's device i, entry i of that list; a UUID, or any entry without it, is itself. Throws
+// tega::Error naming `what` for an index past the list.
+std::string child_visible_device(const std::string& gpu, const std::optional<std::string>& cuda_visible_devices,
+                                 const std::string& what);
+
 }  // namespace tega::pipeline

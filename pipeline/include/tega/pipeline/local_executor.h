@@ -2,9 +2,10 @@
 // Runs jobs as child processes of this one: up to `cpu_slots` CPU jobs at
 // once, and one job at a time per GPU. A job for "cuda" runs on whichever GPU
 // of `gpus` is free, pinned to it with CUDA_VISIBLE_DEVICES (so it sees that
-// GPU alone, as its device 0); with no `gpus` such jobs run one at a time,
-// unpinned. A job for "cuda:N" runs on device N, unpinned, when no other job
-// holds N. Children die with the
+// GPU alone, as its device 0); one of gpu_count N > 1 waits for N free GPUs
+// and is pinned to all of them (its devices 0 to N-1). With no `gpus` such
+// jobs run one at a time, unpinned. A job for "cuda:N" runs on device N,
+// unpinned, when no other job holds N. Children die with the
 // orchestrator (PR_SET_PDEATHSIG), even when it is killed with SIGKILL, so no
 // orphan keeps writing into a workspace that a new run is cleaning up.
 //
@@ -39,18 +40,22 @@ class LocalExecutor : public Executor {
   size_t unfinished() const override { return queue_.size() + running_.size(); }
 
  private:
+  // The GPUs a job holds: `gpus` entries, "N" of "cuda:N", or "cuda"; none for a CPU job.
+  struct Held {
+    std::vector<std::string> gpus;
+    bool pinned = false;  // started with CUDA_VISIBLE_DEVICES naming them
+  };
   struct Running {
     Job job;
-    std::string gpu;     // the GPU it holds (a `gpus` entry, "N" of "cuda:N", or "cuda"); "" for a CPU job
-    bool pinned = false;  // started with CUDA_VISIBLE_DEVICES=gpu
+    Held held;
     std::chrono::steady_clock::time_point started;
   };
 
   void start_ready_jobs(std::vector<JobResult>& results);
-  // The GPU `job` can start on now and whether it is pinned to it; nullopt while it must wait.
-  std::optional<std::pair<std::string, bool>> free_gpu(const Job& job) const;
-  // Throws tega::Error when the log cannot be opened or fork fails.
-  pid_t launch(const Job& job, const std::string& pinned_gpu);
+  // The GPUs `job` can start on now; nullopt while it must wait.
+  std::optional<Held> free_gpus(const Job& job) const;
+  // Throws tega::Error when the log cannot be opened or fork fails. `pinned`: "a,b" or "".
+  pid_t launch(const Job& job, const std::string& pinned);
   bool reap(std::vector<JobResult>& results, bool block);
 
   int cpu_slots_;

@@ -32,7 +32,8 @@ namespace tega::pipeline {
 struct SlurmOptions {
   // sbatch --partition; empty: the cluster's default partition.
   std::string partition;
-  // GPUs a GPU job (one whose Resources name a device) asks for: sbatch --gres=gpu:N. Inside the job
+  // GPUs a GPU job (one whose Resources name a device) asks for: sbatch --gres=gpu:N, or the job's
+  // Resources::gpu_count when larger. Inside the job
   // Slurm's CUDA_VISIBLE_DEVICES numbers them from 0, so a stage's `device: cuda:K` names the job's
   // K-th GPU; K >= gpus_per_job is refused at submission.
   int gpus_per_job = 1;

@@ -54,6 +54,9 @@ struct StageKind {
   // into the one staging directory, which is committed when all of them have succeeded. Empty:
   // the kind does not split (tracking fits a take's frames in order).
   std::function<std::vector<std::vector<std::string>>(const ShardPaths&, int frames_per_job)> split;
+  // The flag through which the command spreads one shard over several GPUs (the stage's
+  // `gpus_per_job`), given the GPUs the job sees as "0,1,...". Empty: the kind uses one GPU.
+  std::string gpus_flag;
 };
 
 const std::vector<StageKind>& stage_kinds();
