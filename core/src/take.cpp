@@ -265,4 +265,27 @@ void record_take_in_capture(const fs::path& capture_root, const TakeInfo& take, 
   write_text_atomic(file, capture.dump(2) + "\n");
 }
 
+void parse_frame_range(const std::string& text, int& first, int& end) {
+  const auto number = [&](const std::string& s) {
+    size_t used = 0;
+    int value = -1;
+    try {
+      value = std::stoi(s, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != s.size() || value < 0) throw Error("--frames '" + text + "': expected A:B, A: or A (frame numbers)");
+    return value;
+  };
+  const size_t colon = text.find(':');
+  if (colon == std::string::npos) {
+    first = number(text);
+    end = first + 1;
+    return;
+  }
+  first = number(text.substr(0, colon));
+  end = colon + 1 == text.size() ? -1 : number(text.substr(colon + 1));
+  if (end != -1 && end <= first) throw Error("--frames '" + text + "': the range is empty");
+}
+
 }  // namespace tega

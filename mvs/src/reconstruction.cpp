@@ -57,29 +57,6 @@ Device resolve_device(const std::string& name) {
   return parse_device(name);
 }
 
-void parse_frame_range(const std::string& text, int& first, int& end) {
-  const auto number = [&](const std::string& s) {
-    size_t used = 0;
-    int value = -1;
-    try {
-      value = std::stoi(s, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != s.size() || value < 0) throw Error("--frames '" + text + "': expected A:B, A: or A (frame numbers)");
-    return value;
-  };
-  const size_t colon = text.find(':');
-  if (colon == std::string::npos) {
-    first = number(text);
-    end = first + 1;
-    return;
-  }
-  first = number(text.substr(0, colon));
-  end = colon + 1 == text.size() ? -1 : number(text.substr(colon + 1));
-  if (end != -1 && end <= first) throw Error("--frames '" + text + "': the range is empty");
-}
-
 namespace {
 
 // The first half of a frame: source views, depth ranges and the depth maps.

@@ -5,6 +5,7 @@
 #include "stage_options.h"
 #include "tega/core/error.h"
 #include "tega/core/options.h"
+#include "tega/core/take.h"
 #include "tega/mvs/reconstruction.h"
 
 namespace tega::cli {
@@ -99,7 +100,7 @@ void add_mvs_command(CLI::App& app) {
     request.takes = args->takes;
     request.out = args->out;
     request.rig = args->rig;
-    if (!args->frames.empty()) mvs::parse_frame_range(args->frames, request.first_frame, request.end_frame);
+    if (!args->frames.empty()) parse_frame_range(args->frames, request.first_frame, request.end_frame);
     const auto summary = mvs::reconstruct_capture(request, options);
     std::printf("%s: %d take(s), %d frame(s) meshed, %d already done\n", args->out.c_str(), summary.takes,
                 summary.frames_done, summary.frames_skipped);

@@ -164,4 +164,17 @@ TEST_F(TakeTest, CaptureIsCreatedWhenAbsent) {
   EXPECT_NO_THROW(tega::validate_capture(tmp.path()));
 }
 
+TEST(Take, FrameRangesParse) {
+  int first = 0, end = 0;
+  tega::parse_frame_range("3:7", first, end);
+  EXPECT_EQ(first, 3);
+  EXPECT_EQ(end, 7);
+  tega::parse_frame_range("5:", first, end);
+  EXPECT_EQ(end, -1);
+  tega::parse_frame_range("4", first, end);
+  EXPECT_EQ(end, 5);
+  EXPECT_THROW(tega::parse_frame_range("7:3", first, end), tega::Error);
+  EXPECT_THROW(tega::parse_frame_range("a:b", first, end), tega::Error);
+}
+
 }  // namespace

@@ -116,18 +116,5 @@ TEST(Mvs, AFrameTooFewCamerasSeeIsRefused) {
   EXPECT_FALSE(fs::exists(dir / "meshes" / "expressions" / "000001.ply"));
 }
 
-TEST(Mvs, FrameRangesParse) {
-  int first = 0, end = 0;
-  parse_frame_range("3:7", first, end);
-  EXPECT_EQ(first, 3);
-  EXPECT_EQ(end, 7);
-  parse_frame_range("5:", first, end);
-  EXPECT_EQ(end, -1);
-  parse_frame_range("4", first, end);
-  EXPECT_EQ(end, 5);
-  EXPECT_THROW(parse_frame_range("7:3", first, end), Error);
-  EXPECT_THROW(parse_frame_range("a:b", first, end), Error);
-}
-
 }  // namespace
 }  // namespace tega::mvs

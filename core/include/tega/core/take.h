@@ -44,6 +44,10 @@ void write_take(const TakeInfo& take, const std::filesystem::path& take_folder);
 // offending file.
 void validate_take(const TakeInfo& take);
 
+// A command's `--frames`: "A:B" (B exclusive), "A:" or "A" into [first, end), end -1 for "to the
+// take's end". Throws tega::Error.
+void parse_frame_range(const std::string& text, int& first, int& end);
+
 struct CaptureTake {
   std::string name, kind;
   int frames = 0;

@@ -108,7 +108,4 @@ FrameTimings reconstruct_photos(const PhotoRequest& request, const Options& opti
 FrameTimings mesh_workspace(const std::filesystem::path& workspace, const std::filesystem::path& out,
                             const Options& options, const std::string& type = "geometric");
 
-// "A:B" (B exclusive), "A:" or "A" into [first, end). Throws tega::Error.
-void parse_frame_range(const std::string& text, int& first, int& end);
-
 }  // namespace tega::mvs
