@@ -5,6 +5,7 @@
 #include "stage_options.h"
 #include "tega/core/error.h"
 #include "tega/core/options.h"
+#include "tega/core/take.h"
 #include "tega/scoring/tracking_scores.h"
 #include "tega/tracking/tracking.h"
 
@@ -13,7 +14,7 @@ namespace tega::cli {
 namespace {
 
 struct TrackArguments {
-  std::string capture, meshes, model, out, identity, rig, landmarks;
+  std::string capture, meshes, model, out, identity, rig, landmarks, frames;
   std::vector<std::string> takes;
   int threads = -1;
   StageOptionFlags options;
@@ -45,6 +46,9 @@ void add_track_command(CLI::App& app) {
   cmd->add_option("--out", args->out, "TRACKED/: identity.json, <take>/<frame>.bin/.json, <take>/report/.");
   cmd->add_option("--identity", args->identity,
                   "An identity.json from an earlier run of this subject: reused instead of fitting one.");
+  cmd->add_option("--frames", args->frames,
+                  "Frames A:B (B exclusive), A: or A of each take (default: all): a range starts afresh, and "
+                  "processes tracking a take's ranges at once share one identity (docs/tracking.md#in-frame-ranges).");
   cmd->add_option("--rig", args->rig, "Rig file (default: the capture's rig.json).");
   cmd->add_option("--landmarks", args->landmarks, "A dlib 68-point shape predictor (.dat) for landmark terms.");
   cmd->add_option("--threads", args->threads, "Worker threads (default: all).");
@@ -64,6 +68,7 @@ void add_track_command(CLI::App& app) {
     if (args->capture.empty() || args->meshes.empty() || args->out.empty())
       throw Error("tega track: --capture, --meshes and --out are required");
     tracking::TrackRequest request{args->capture, args->takes, args->meshes, args->out, args->rig};
+    if (!args->frames.empty()) parse_frame_range(args->frames, request.first_frame, request.end_frame);
     const auto summary = tracking::track_capture(request, options);
     std::printf("%s: %d take(s), %d frame(s) tracked, %d failed, %d without a scan, %d already done\n",
                 args->out.c_str(), summary.takes, summary.frames_tracked, summary.frames_failed,

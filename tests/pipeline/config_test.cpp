@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "tega/pipeline/fingerprint.h"
 #include "tega/pipeline/stage_graph.h"
 #include "test_support.h"
 
@@ -73,6 +74,31 @@ TEST(PipelineConfig, ATrainStageMayTakeSeveralGpusAJob) {
                   .find("stages.train.gpus_per_job must be a whole number of GPUs, at least 1"),
               std::string::npos)
         << bad;
+}
+
+// The key of each stage's shard: what its outputs depend on, and nothing else.
+std::map<std::string, std::string> shard_keys(const std::string& stages) {
+  const StageGraph graph(parse("workspace: ws\nstages:\n  synth: {kind: synth_raw}\n"
+                               "  calibrate: {after: synth}\n  mvs: {after: calibrate}\n" +
+                               stages),
+                         all_commands);
+  std::map<std::string, std::string> keys;
+  for (size_t i = 0; i < graph.stages().size(); ++i)
+    keys[graph.stages()[i].name()] =
+        fingerprint_shard(graph, i, 0, "test", [](size_t, size_t) { return std::string("upstream"); }).key();
+  return keys;
+}
+
+TEST(Fingerprint, HoldsTheSplitsAndGpusThatChangeOutputsAndNoOthers) {
+  const auto plain = shard_keys("  track: {after: mvs}\n  dataset: {after: track}\n  train: {after: dataset}\n");
+  const auto split = shard_keys("  track: {after: mvs, frames_per_job: 10}\n  dataset: {after: track}\n"
+                                "  train: {after: dataset, gpus_per_job: 4}\n");
+  EXPECT_NE(plain.at("track"), split.at("track")) << "each range's first frame is fitted afresh";
+  EXPECT_NE(plain.at("train"), split.at("train")) << "four GPUs see four views a step";
+  EXPECT_EQ(plain.at("dataset"), split.at("dataset"));  // the upstream hash stands for track's outputs here
+  const auto meshes_in_jobs = shard_keys("  mvs2: {kind: mvs, after: calibrate, frames_per_job: 5}\n");
+  const auto meshes_whole = shard_keys("  mvs2: {kind: mvs, after: calibrate}\n");
+  EXPECT_EQ(meshes_in_jobs.at("mvs2"), meshes_whole.at("mvs2")) << "split meshes are the same bytes";
 }
 
 TEST(PipelineConfig, OptionsAreCanonicalWhateverTheirOrderAndLayout) {

@@ -73,7 +73,8 @@ std::string chain_config(const fs::path& ict) {
          "      patch_match: {iterations: 3, geometric_iterations: 1}\n"
          "      fusion: {voxel_size_m: 0.0008}\n"
          "      surface: {poisson_depth: 8, threads: 1}\n"
-         "  track: {after: [mvs], options: {model: " + model + "}}\n"
+         // One job a take, at once: they share one identity (tracking.md#in-frame-ranges).
+         "  track: {after: [mvs], frames_per_job: 1, options: {model: " + model + "}}\n"
          "  dataset: {after: [track], options: {frames: 2, test_takes: [freestyle], test_camera_count: 1, downsample: 1}}\n"
          "  train:\n"
          "    after: [dataset]\n"

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "small_studio.h"
 #include "test_support.h"
@@ -236,6 +237,34 @@ TEST(StudioTracking, TracksTegasOwnMeshesWithinTheTargets) {
   const auto flowed = nlohmann::json::parse(read_text_file(dir / "tracked_on_truth" / "expressions" / "000004.json"));
   EXPECT_GT(flowed["residuals"]["flow_points"].get<int>(), 1000);
   EXPECT_LT(flowed["residuals"]["flow_rms_px"].get<double>(), 5.0);
+
+  // In two frame ranges at once (a split track shard): one identity for both, fitted once under
+  // the lock; the range that finishes the take writes its summary; the targets as one process
+  // meets them.
+  {
+    Options ranged = options;
+    TrackRequest first_half{capture, {}, dir / "true_meshes", dir / "tracked_in_ranges", {}, 0, 4};
+    TrackRequest second_half = first_half;
+    second_half.first_frame = 4;
+    second_half.end_frame = -1;
+    std::thread other([&] { track_capture(second_half, ranged); });
+    track_capture(first_half, ranged);
+    other.join();
+    const fs::path take = dir / "tracked_in_ranges" / "expressions";
+    ASSERT_TRUE(fs::exists(take / "track.json"));
+    EXPECT_EQ(nlohmann::json::parse(read_text_file(take / "track.json"))["tracked"], kFrames);
+    EXPECT_TRUE(fs::exists(take / "report" / "residuals.png"));
+    const scoring::TrackScores split = scoring::score_against_studio(dir / "tracked_in_ranges", truth);
+    print_scores("true meshes, two ranges at once", split);
+    expect_within(split, {0.002, 0.005, 1.0, 0.95, 0.85});
+    // A range of a take tracked with other options stops rather than remove the others' frames.
+    Options other_options = ranged;
+    other_options.icp_iterations += 1;
+    TrackRequest rerun = first_half;
+    const std::string refused = test::error_message([&] { track_capture(rerun, other_options); });
+    EXPECT_NE(refused.find("holds frames tracked with other options"), std::string::npos) << refused;
+    EXPECT_TRUE(fs::exists(take / "000007.json"));
+  }
 
   // A frame without a scan is recorded and skipped; its neighbours are
   // tracked (the next one starting afresh when the gap is too wide). The run

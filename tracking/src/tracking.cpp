@@ -1,7 +1,14 @@
 #include "tega/tracking/tracking.h"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "frame_record.h"
 #include "report.h"
@@ -50,29 +57,94 @@ struct TakeContext {
   fs::path meshes;  // MESHES/<take>
   fs::path out;     // TRACKED/<take>
   std::string made_with;
+  int first_frame, end_frame;  // the frames to track, [first, end)
+  bool whole_take() const { return first_frame == 0 && end_frame == take.frames; }
+};
+
+// An exclusive flock on `file` while the object lives; waits for another process's.
+class FileLock {
+ public:
+  explicit FileLock(const fs::path& file) : fd_(::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644)) {
+    if (fd_ < 0) throw Error(file, std::string("cannot be opened for locking: ") + std::strerror(errno));
+    while (::flock(fd_, LOCK_EX) != 0)
+      if (errno != EINTR) throw Error(file, std::string("cannot be locked: ") + std::strerror(errno));
+  }
+  ~FileLock() { ::close(fd_); }  // releases the lock
+  FileLock(const FileLock&) = delete;
+  FileLock& operator=(const FileLock&) = delete;
+
+ private:
+  int fd_;
 };
 
 bool needs_photos(const Options& o, const landmarks::LandmarkDetector* landmarks) {
   return o.flow.enabled || o.eyelids.enabled || landmarks;
 }
 
-void track_take(const TakeContext& t, const Options& options, TrackSummary& summary, ThreadPool& pool) {
+// Frames written with other options or another identity are redone when the whole take is
+// tracked. A range never removes them: other ranges may be writing beside it.
+void claim_take_folder(const TakeContext& t) {
   const fs::path options_file = t.out / "made_with.yaml";
-  if (fs::exists(t.out / "track.json") && fs::exists(options_file) && read_text_file(options_file) == t.made_with) {
+  if (fs::exists(options_file) && read_text_file(options_file) != t.made_with) {
+    if (!t.whole_take())
+      throw Error(t.out, "holds frames tracked with other options, identity or rig: remove it, or track the whole "
+                         "take, which redoes them");
+    remove_tree(t.out);
+  }
+  fs::create_directories(t.out);
+  if (!fs::exists(options_file)) write_text_atomic(options_file, t.made_with);  // ranges at once write the same
+}
+
+// Every frame's record of the take, read back; nullopt while a frame has none (another range of
+// the take is still at work).
+std::optional<std::vector<FrameRecord>> take_records(const TakeContext& t) {
+  std::vector<FrameRecord> records;
+  for (int frame = 0; frame < t.take.frames; ++frame) {
+    auto stored = read_frame_record(t.out, frame, t.model);
+    if (!stored) return std::nullopt;
+    records.push_back(stored->record);
+  }
+  return records;
+}
+
+// The take's report and track.json, last. Two ranges finishing at once may both write them: from
+// the same records on disk, the same files.
+void write_take_summary(const TakeContext& t, const std::vector<FrameRecord>& records, const Options& options,
+                        ThreadPool& pool) {
+  write_take_report(t.out / "report", records, t.take, t.cameras, t.model, options.report_overlays, pool);
+  nlohmann::json summary_json;
+  summary_json["take"] = t.take.name;
+  summary_json["frames"] = t.take.frames;
+  int tracked = 0;
+  for (const auto& r : records) tracked += r.status == "tracked";
+  summary_json["tracked"] = tracked;
+  summary_json["frames_not_tracked"] = nlohmann::json::array();
+  for (const auto& r : records)
+    if (r.status != "tracked") summary_json["frames_not_tracked"].push_back({{"frame", r.frame}, {"status", r.status}, {"reason", r.reason}});
+  // A take without a single tracked frame is no track; the frames' records
+  // stay, and with no track.json a rerun fails the same way.
+  if (tracked == 0 && !records.empty())
+    throw Error(t.out, "no frame of take " + t.take.name + " was tracked (frame " + std::to_string(records.front().frame) +
+                           " " + records.front().status + ": " + records.front().reason + "); see the frame records there");
+  write_text_atomic(t.out / "track.json", summary_json.dump(2) + "\n");
+}
+
+void track_take(const TakeContext& t, const Options& options, TrackSummary& summary, ThreadPool& pool) {
+  const int count = t.end_frame - t.first_frame;
+  if (fs::exists(t.out / "track.json") && fs::exists(t.out / "made_with.yaml") &&
+      read_text_file(t.out / "made_with.yaml") == t.made_with) {
     logging::info("track: take %s is tracked already with these options", t.take.name.c_str());
-    summary.frames_kept += t.take.frames;
+    summary.frames_kept += count;
     return;
   }
-  // Frames written with other options or another identity are redone.
-  if (fs::exists(t.out) && (!fs::exists(options_file) || read_text_file(options_file) != t.made_with)) remove_tree(t.out);
-  fs::create_directories(t.out);
-  write_text_atomic(options_file, t.made_with);
+  claim_take_folder(t);
 
+  // A range starts afresh, as after a failed frame: no earlier frame to follow.
   TakeTracker tracker(t.model, t.subject, t.photo_cameras, options, t.landmarks);
   std::vector<FrameRecord> records;
-  Progress progress("track " + t.take.name, t.take.frames, "frames");
+  Progress progress("track " + t.take.name, count, "frames");
   bool follows = false;  // the next frame follows an accepted one
-  for (int frame = 0; frame < t.take.frames; ++frame) {
+  for (int frame = t.first_frame; frame < t.end_frame; ++frame) {
     if (auto done = read_frame_record(t.out, frame, t.model, &t.subject)) {
       if (done->record.status == "tracked") {
         tracker.resume_from(done->state);
@@ -126,22 +198,16 @@ void track_take(const TakeContext& t, const Options& options, TrackSummary& summ
     progress.advance();
   }
   progress.finish();
-  write_take_report(t.out / "report", records, t.take, t.cameras, t.model, options.report_overlays, pool);
-  nlohmann::json summary_json;
-  summary_json["take"] = t.take.name;
-  summary_json["frames"] = t.take.frames;
-  int tracked = 0;
-  for (const auto& r : records) tracked += r.status == "tracked";
-  summary_json["tracked"] = tracked;
-  summary_json["frames_not_tracked"] = nlohmann::json::array();
-  for (const auto& r : records)
-    if (r.status != "tracked") summary_json["frames_not_tracked"].push_back({{"frame", r.frame}, {"status", r.status}, {"reason", r.reason}});
-  // A take without a single tracked frame is no track; the frames' records
-  // stay, and with no track.json a rerun fails the same way.
-  if (tracked == 0 && !records.empty())
-    throw Error(t.out, "no frame of take " + t.take.name + " was tracked (frame " + std::to_string(records.front().frame) +
-                           " " + records.front().status + ": " + records.front().reason + "); see the frame records there");
-  write_text_atomic(t.out / "track.json", summary_json.dump(2) + "\n");
+  if (t.whole_take()) {
+    write_take_summary(t, records, options, pool);
+  } else if (const auto all = take_records(t)) {
+    logging::info("track: take %s: frames %d to %d were the last to track; its summary follows", t.take.name.c_str(),
+                  t.first_frame, t.end_frame - 1);
+    write_take_summary(t, *all, options, pool);
+  } else {
+    logging::info("track: take %s, frames %d to %d tracked; the range that finishes the take writes its summary",
+                  t.take.name.c_str(), t.first_frame, t.end_frame - 1);
+  }
 }
 
 // The first frames of the first take, each with its scan and photos.
@@ -190,16 +256,19 @@ TrackSummary track_capture(const TrackRequest& request, const Options& options) 
   const TakeInfo first = read_take(capture.root / "takes" / takes.front());
   const fs::path identity_file = request.out / "identity.json";
   SubjectIdentity subject;
-  if (!options.identity.empty()) {
-    subject = read_identity(options.identity, model);
-    if (fs::absolute(options.identity) != fs::absolute(identity_file)) write_identity(subject, model, identity_file);
-  } else if (fs::exists(identity_file) && fs::exists(request.out / "identity_options.yaml") &&
-             read_text_file(request.out / "identity_options.yaml") == options_to_yaml(options)) {
-    subject = read_identity(identity_file, model);
-  } else {
-    subject = identity_of(request, first, take_cameras(first, rig, rig_file), model, options, landmarks.get(), pool);
-    write_identity(subject, model, identity_file);
-    write_text_atomic(request.out / "identity_options.yaml", options_to_yaml(options));
+  {
+    const FileLock identity_lock(request.out / ".identity.lock");  // ranges at once: one fits, the others read it
+    if (!options.identity.empty()) {
+      subject = read_identity(options.identity, model);
+      if (fs::absolute(options.identity) != fs::absolute(identity_file)) write_identity(subject, model, identity_file);
+    } else if (fs::exists(identity_file) && fs::exists(request.out / "identity_options.yaml") &&
+               read_text_file(request.out / "identity_options.yaml") == options_to_yaml(options)) {
+      subject = read_identity(identity_file, model);
+    } else {
+      subject = identity_of(request, first, take_cameras(first, rig, rig_file), model, options, landmarks.get(), pool);
+      write_identity(subject, model, identity_file);
+      write_text_atomic(request.out / "identity_options.yaml", options_to_yaml(options));
+    }
   }
 
   const std::string made_with = options_to_yaml(options) + "# identity\n" + read_text_file(identity_file) +
@@ -212,8 +281,12 @@ TrackSummary track_capture(const TrackRequest& request, const Options& options) 
     const std::vector<Camera> photo_rig = photo_cameras(cameras, factor);
     logging::info("track: take %s, %d frames, %zu cameras, photos at 1/%d size", name.c_str(), take.frames,
                   cameras.size(), factor);
+    const int end = request.end_frame < 0 ? take.frames : std::min(request.end_frame, take.frames);
+    if (request.first_frame >= take.frames)
+      throw Error("track: take " + name + " has frames 0 to " + std::to_string(take.frames - 1) + "; asked for " +
+                  std::to_string(request.first_frame) + " on");
     track_take({take, cameras, factor, photo_rig, model, subject, landmarks.get(), request.meshes / name,
-                request.out / name, made_with},
+                request.out / name, made_with, request.first_frame, end},
                options, summary, pool);
     ++summary.takes;
   }

@@ -61,6 +61,8 @@ Fingerprint fingerprint_shard(const StageGraph& graph, size_t stage_index, size_
   }
   // More GPUs a step are more views a step: another training.
   if (stage.config->gpus_per_job > 1) fp.inputs.emplace_back("gpus_per_job", std::to_string(stage.config->gpus_per_job));
+  if (stage.kind->split_changes_outputs && stage.config->frames_per_job > 0)
+    fp.inputs.emplace_back("frames_per_job", std::to_string(stage.config->frames_per_job));
   if (stage.kind->reads_capture) {
     if (subject.capture.empty()) {
       throw Error(config.source, "stage '" + stage.name() + "' (kind " + stage.kind->name + ") reads a capture: subject '" +

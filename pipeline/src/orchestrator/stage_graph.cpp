@@ -60,7 +60,7 @@ StageGraph::StageGraph(PipelineConfig config, const CommandAvailable& available)
     check_options(config_, sc, *stage.kind);
     if (sc.frames_per_job > 0 && !stage.kind->split) {
       throw Error(source, "stage '" + sc.name + "': frames_per_job: a " + stage.kind->name +
-                              " shard runs as one job (only mvs and matte split into jobs)");
+                              " shard runs as one job (only mvs, track and matte split into jobs)");
     }
     if (sc.gpus_per_job > 1 && stage.kind->gpus_flag.empty()) {
       throw Error(source, "stage '" + sc.name + "': gpus_per_job: a " + stage.kind->name +

@@ -232,7 +232,7 @@ std::vector<StageKind> make_stage_kinds() {
   };
   mvs.split = by_frame_ranges;
   kinds.push_back(mvs);
-  // Every performance take, its frames in order; the model is an option (a path).
+  // Every performance take, its frames in order (or ranges of them at once); the model is an option (a path).
   StageKind track;
   track.name = "track";
   track.summary = "fits the blendshape head model to every frame's mesh (tega track)";
@@ -247,6 +247,8 @@ std::vector<StageKind> make_stage_kinds() {
                         "--meshes", p.artifacts.at("meshes").string(), "--out", (p.output / "tracked").string()},
                        p);
   };
+  track.split = by_frame_ranges;  // each range fitted afresh at its first frame (docs/tracking.md#in-frame-ranges)
+  track.split_changes_outputs = true;
   kinds.push_back(track);
   // Alpha mattes of every performance image, in the captured image space;
   // resumes from the mattes an interrupted shard wrote.

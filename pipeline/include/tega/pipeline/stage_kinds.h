@@ -52,8 +52,11 @@ struct StageKind {
   // How a shard splits into jobs that run at once (the stage's `frames_per_job`): each job's
   // arguments after `arguments`' (e.g. --take T --frames A:B). The jobs write disjoint files
   // into the one staging directory, which is committed when all of them have succeeded. Empty:
-  // the kind does not split (tracking fits a take's frames in order).
+  // the kind does not split.
   std::function<std::vector<std::vector<std::string>>(const ShardPaths&, int frames_per_job)> split;
+  // Whether the split changes the outputs (track fits each range's first frame afresh): then
+  // `frames_per_job` is part of the shard's fingerprint.
+  bool split_changes_outputs = false;
   // The flag through which the command spreads one shard over several GPUs (the stage's
   // `gpus_per_job`), given the GPUs the job sees as "0,1,...". Empty: the kind uses one GPU.
   std::string gpus_flag;

@@ -8,7 +8,11 @@
 //   TRACKED/<take>/report/                         residual plots and overlays (PNG)
 //   TRACKED/<take>/track.json                      the take's summary, written last
 // Takes are independent once the identity is known; a rerun with the same
-// options resumes each take after its last written frame.
+// options resumes each take after its last written frame. A take may also be
+// tracked in frame ranges by processes at once (a split `track` shard): the
+// first to need the identity fits it while the others wait for it (a lock
+// file), each range's first frame is fitted afresh, and the range that
+// completes the take writes its summary and report.
 
 #include <filesystem>
 #include <string>
@@ -26,6 +30,7 @@ struct TrackRequest {
   std::filesystem::path meshes;    // MESHES/<take>/<frame:06d>.ply (tega mvs)
   std::filesystem::path out;       // TRACKED/
   std::filesystem::path rig;       // empty: the capture's rig.json
+  int first_frame = 0, end_frame = -1;  // frames [first, end) of each take; end -1: to the take's end
 };
 
 struct TrackSummary {
