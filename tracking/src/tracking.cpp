@@ -85,11 +85,14 @@ bool needs_photos(const Options& o, const landmarks::LandmarkDetector* landmarks
 // tracked. A range never removes them: other ranges may be writing beside it.
 void claim_take_folder(const TakeContext& t) {
   const fs::path options_file = t.out / "made_with.yaml";
-  if (fs::exists(options_file) && read_text_file(options_file) != t.made_with) {
-    if (!t.whole_take())
+  const bool recorded = fs::exists(options_file);
+  if (fs::exists(t.out) && !(recorded && read_text_file(options_file) == t.made_with)) {
+    if (t.whole_take()) {
+      remove_tree(t.out);
+    } else if (recorded) {
       throw Error(t.out, "holds frames tracked with other options, identity or rig: remove it, or track the whole "
                          "take, which redoes them");
-    remove_tree(t.out);
+    }  // else another range has only just made the folder
   }
   fs::create_directories(t.out);
   if (!fs::exists(options_file)) write_text_atomic(options_file, t.made_with);  // ranges at once write the same
