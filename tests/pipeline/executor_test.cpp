@@ -150,6 +150,23 @@ TEST(LocalExecutor, AJobOfSeveralGpusWaitsForThatManyFreeOnesAndIsPinnedToAllOfT
   EXPECT_NE(read_text_file(dir / "logs/pair.log").find(" on GPUs " + pair + ":"), std::string::npos);
 }
 
+TEST(LocalExecutor, AJobWaitingForSeveralGpusIsNotOvertakenByLaterOnes) {
+  test::TempDir dir;
+  LocalExecutor executor(4, {"0", "1"});
+  const auto on_gpus = [&](const std::string& id, int count, const std::string& script) {
+    Job job = shell_job(id, script, dir, "cuda");
+    job.resources.gpu_count = count;
+    return job;
+  };
+  executor.submit(on_gpus("first", 1, "sleep 0.3"));
+  executor.submit(on_gpus("pair", 2, "touch pair.started; sleep 0.1"));
+  // GPU 1 is free from the start: taking it would keep pair waiting.
+  executor.submit(on_gpus("later", 1, "[ -e pair.started ] || exit 5"));
+  const auto results = wait_for_all(executor, 30s);
+  ASSERT_EQ(results.size(), 3u);
+  for (const auto& r : results) EXPECT_TRUE(r.succeeded) << r.id << ": " << r.failure;
+}
+
 TEST(LocalExecutor, WithoutGpusRunsCudaJobsOneAtATimeUnpinned) {
   test::TempDir dir;
   const ScopedEnvironment machine("CUDA_VISIBLE_DEVICES", "5,6");

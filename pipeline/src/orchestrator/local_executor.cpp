@@ -130,8 +130,12 @@ std::optional<LocalExecutor::Held> LocalExecutor::free_gpus(const Job& job) cons
 void LocalExecutor::start_ready_jobs(std::vector<JobResult>& results) {
   int cpu_running = 0;
   for (const auto& [pid, r] : running_) cpu_running += r.held.gpus.empty() ? 1 : 0;
+  // Jobs for any of the run's GPUs start in queue order: a job waiting for several GPUs is not
+  // starved by later ones that each take one as it frees.
+  bool pooled_waiting = false;
   for (auto it = queue_.begin(); it != queue_.end();) {
     const bool cpu_job = it->resources.gpu_device.empty();
+    const bool pooled = it->resources.gpu_device == "cuda" && !gpus_.empty();
     if (!cpu_job && !gpus_.empty() && it->resources.gpu_count > int(gpus_.size())) {
       results.push_back({it->id, false,
                          "could not start: it needs " + std::to_string(it->resources.gpu_count) +
@@ -141,7 +145,8 @@ void LocalExecutor::start_ready_jobs(std::vector<JobResult>& results) {
       continue;
     }
     std::optional<Held> gpus;
-    if (cpu_job ? cpu_running >= cpu_slots_ : !(gpus = free_gpus(*it))) {
+    if (cpu_job ? cpu_running >= cpu_slots_ : (pooled && pooled_waiting) || !(gpus = free_gpus(*it))) {
+      pooled_waiting = pooled_waiting || pooled;
       ++it;
       continue;
     }
