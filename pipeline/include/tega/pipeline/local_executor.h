@@ -3,10 +3,10 @@
 // once, and one job at a time per GPU. A job for "cuda" runs on whichever GPU
 // of `gpus` is free, pinned to it with CUDA_VISIBLE_DEVICES (so it sees that
 // GPU alone, as its device 0); one of gpu_count N > 1 waits for N free GPUs
-// and is pinned to all of them (its devices 0 to N-1); such jobs start in
-// queue order, so a later one never takes a GPU an earlier one waits for. With no `gpus` such
-// jobs run one at a time, unpinned. A job for "cuda:N" runs on device N,
-// unpinned, when no other job holds N. Children die with the
+// and is pinned to all of them (its devices 0 to N-1). Such jobs start in
+// queue order: a later one never takes a GPU that an earlier one waits for.
+// With no `gpus` they run one at a time, unpinned. A job for "cuda:N" runs on
+// device N, unpinned, when no other job holds N. Children die with the
 // orchestrator (PR_SET_PDEATHSIG), even when it is killed with SIGKILL, so no
 // orphan keeps writing into a workspace that a new run is cleaning up.
 //
