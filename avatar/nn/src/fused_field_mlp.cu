@@ -114,7 +114,6 @@ __device__ __forceinline__ SiluDerivatives silu_derivatives(float x) {
 __device__ __forceinline__ Bits bits(float x) { return __bfloat16_as_ushort(__float2bfloat16_rn(x)); }
 __device__ __forceinline__ uint32_t pair(Bits lo, Bits hi) { return uint32_t(lo) | (uint32_t(hi) << 16); }
 __device__ __forceinline__ uint32_t pack(float lo, float hi) { return pair(bits(lo), bits(hi)); }
-__device__ __forceinline__ uint32_t load32(const Bits* p) { return *reinterpret_cast<const uint32_t*>(p); }
 
 __device__ __forceinline__ void mma(C& c, const A& a, uint32_t b0, uint32_t b1) {
   asm volatile(
@@ -132,20 +131,48 @@ struct Lane {
 
 __device__ __forceinline__ Lane lane_of() { return {int(threadIdx.x % 32) / 4, int(threadIdx.x % 32) % 4}; }
 
-// B[k][n] = w[n][k] for w row-major [n rows][k columns] (a forward product).
-__device__ __forceinline__ void b_forward(const Bits* w, int ld, int n0, int k0, Lane l, uint32_t& b0, uint32_t& b1) {
-  const Bits* p = w + (n0 + l.g) * ld + k0 + 2 * l.t;
-  b0 = load32(p);
-  b1 = load32(p + 8);
+// B fragments come from shared memory four 8×8 matrices at a time (ldmatrix.x4:
+// lanes 8j..8j+7 give the rows of matrix j, 16-byte aligned as the strides and
+// offsets are multiples of 8 elements): two fragments (b[0], b[1] and b[2], b[3])
+// per instruction instead of four 32-bit loads each.
+struct Fragments {
+  uint32_t b[4];
+};
+
+__device__ __forceinline__ Fragments ldmatrix_x4(const Bits* row) {
+  Fragments f;
+  const auto address = static_cast<uint32_t>(__cvta_generic_to_shared(row));
+  asm volatile("ldmatrix.sync.aligned.m8n8.x4.shared.b16 {%0, %1, %2, %3}, [%4];\n"
+               : "=r"(f.b[0]), "=r"(f.b[1]), "=r"(f.b[2]), "=r"(f.b[3])
+               : "r"(address));
+  return f;
+}
+__device__ __forceinline__ Fragments ldmatrix_x4_trans(const Bits* row) {
+  Fragments f;
+  const auto address = static_cast<uint32_t>(__cvta_generic_to_shared(row));
+  asm volatile("ldmatrix.sync.aligned.m8n8.x4.trans.shared.b16 {%0, %1, %2, %3}, [%4];\n"
+               : "=r"(f.b[0]), "=r"(f.b[1]), "=r"(f.b[2]), "=r"(f.b[3])
+               : "r"(address));
+  return f;
 }
 
-// B[k][n] = w[k][n] for w row-major [k rows][n columns] (a backward product):
-// two 8×8 matrices loaded transposed, lanes 0-15 giving rows k0..k0+15
-// (row starts 16-byte aligned: strides and n0 are multiples of 8 elements).
-__device__ __forceinline__ void b_backward(const Bits* w, int ld, int n0, int k0, uint32_t& b0, uint32_t& b1) {
-  const Bits* row = w + (k0 + int(threadIdx.x % 16)) * ld + n0;
-  const auto address = static_cast<uint32_t>(__cvta_generic_to_shared(row));
-  asm volatile("ldmatrix.sync.aligned.m8n8.x2.trans.shared.b16 {%0, %1}, [%2];\n" : "=r"(b0), "=r"(b1) : "r"(address));
+__device__ __forceinline__ int matrix_of_lane() { return int(threadIdx.x % 32) / 8; }
+
+// B[k][n] = w[n][k] for w row-major [n rows][k columns] (a forward product):
+// the fragments of n-tiles n0 and n0+8 at k step k0.
+__device__ __forceinline__ Fragments b_forward_tiles(const Bits* w, int ld, int n0, int k0) {
+  const int m = matrix_of_lane();
+  return ldmatrix_x4(w + (n0 + (m / 2) * 8 + int(threadIdx.x % 8)) * ld + k0 + (m % 2) * 8);
+}
+// The same for one n-tile at k steps k0 and k0+16.
+__device__ __forceinline__ Fragments b_forward_steps(const Bits* w, int ld, int n0, int k0) {
+  return ldmatrix_x4(w + (n0 + int(threadIdx.x % 8)) * ld + k0 + matrix_of_lane() * 8);
+}
+
+// B[k][n] = w[k][n] for w row-major [k rows][n columns] (a backward product),
+// loaded transposed: the fragments of n-tiles n0 and n0+8 at k step k0.
+__device__ __forceinline__ Fragments b_backward_tiles(const Bits* w, int ld, int n0, int k0) {
+  return ldmatrix_x4_trans(w + (k0 + int(threadIdx.x % 16)) * ld + n0 + (matrix_of_lane() / 2) * 8);
 }
 
 // Two consecutive bfloat16 of a global row-major matrix, zero past its rows
@@ -252,27 +279,37 @@ __device__ __forceinline__ void bias_tiles(C* c, int tiles, const float* bias, L
   }
 }
 
+// out += a · wᵀ over the hidden width's n-tiles, at k step k0 of w.
+__device__ __forceinline__ void forward_tiles(C (&out)[kHiddenBlocks], const A& a, const Bits* w, int ld, int k0) {
+#pragma unroll
+  for (int nb = 0; nb < kHiddenBlocks; nb += 2) {
+    const Fragments f = b_forward_tiles(w, ld, nb * 8, k0);
+    mma(out[nb], a, f.b[0], f.b[1]);
+    mma(out[nb + 1], a, f.b[2], f.b[3]);
+  }
+}
+
+// out += g · w over the hidden width's n-tiles, w's rows k0..k0+15 (a backward product).
+__device__ __forceinline__ void backward_tiles(C (&out)[kHiddenBlocks], const A& g, const Bits* w, int ld, int k0) {
+#pragma unroll
+  for (int nb = 0; nb < kHiddenBlocks; nb += 2) {
+    const Fragments f = b_backward_tiles(w, ld, nb * 8, k0);
+    mma(out[nb], g, f.b[0], f.b[1]);
+    mma(out[nb + 1], g, f.b[2], f.b[3]);
+  }
+}
+
 // Pre-activations of the first layer, [E, condition]·W0ᵀ + b0.
 __device__ void first_layer(C (&z)[kHiddenBlocks], const Shape& s, const Layout& lay, const Shared& sh,
                             const Inputs& in, int64_t r0, Lane l) {
   bias_tiles(z, kHiddenBlocks, sh.b0, l);
   for (int k0 = 0; k0 < lay.encoding_steps_width; k0 += 16) {
     const A a = global_a(in.encoding, s.points, s.encoding_width, r0, k0, l);
-#pragma unroll
-    for (int nb = 0; nb < kHiddenBlocks; ++nb) {
-      uint32_t b0, b1;
-      b_forward(sh.w0, lay.first_stride, nb * 8, k0, l, b0, b1);
-      mma(z[nb], a, b0, b1);
-    }
+    forward_tiles(z, a, sh.w0, lay.first_stride, k0);
   }
   for (int k0 = 0; k0 < s.condition_channels; k0 += 16) {
     const A a = global_a(in.condition, s.points, s.condition_channels, r0, k0, l);
-#pragma unroll
-    for (int nb = 0; nb < kHiddenBlocks; ++nb) {
-      uint32_t b0, b1;
-      b_forward(sh.w0, lay.first_stride, nb * 8, lay.encoding_steps_width + k0, l, b0, b1);
-      mma(z[nb], a, b0, b1);
-    }
+    forward_tiles(z, a, sh.w0, lay.first_stride, lay.encoding_steps_width + k0);
   }
 }
 
@@ -286,13 +323,7 @@ __device__ void first_tangent(C (&t)[kHiddenBlocks], const Shape& s, const Share
                               int64_t r0, Lane l) {
   bias_tiles(t, kHiddenBlocks, nullptr, l);
   const A a = derivative_a(s, in, axis, r0, l);
-  const Bits* w = sh.wa + axis * kHidden * kNarrowStride;
-#pragma unroll
-  for (int nb = 0; nb < kHiddenBlocks; ++nb) {
-    uint32_t b0, b1;
-    b_forward(w, kNarrowStride, nb * 8, 0, l, b0, b1);
-    mma(t[nb], a, b0, b1);
-  }
+  forward_tiles(t, a, sh.wa + axis * kHidden * kNarrowStride, kNarrowStride, 0);
 }
 
 // A hidden layer's product x·W1ᵀ (+ b1 when given) from A fragments.
@@ -300,14 +331,7 @@ __device__ void hidden_layer(C (&out)[kHiddenBlocks], const A (&x)[kHiddenSteps]
                              Lane l) {
   bias_tiles(out, kHiddenBlocks, bias, l);
 #pragma unroll
-  for (int kb = 0; kb < kHiddenSteps; ++kb) {
-#pragma unroll
-    for (int nb = 0; nb < kHiddenBlocks; ++nb) {
-      uint32_t b0, b1;
-      b_forward(sh.w1, kHiddenStride, nb * 8, kb * 16, l, b0, b1);
-      mma(out[nb], x[kb], b0, b1);
-    }
-  }
+  for (int kb = 0; kb < kHiddenSteps; ++kb) forward_tiles(out, x[kb], sh.w1, kHiddenStride, kb * 16);
 }
 
 // The output layer's product x·W2ᵀ (+ b2 when given): one 8-column tile.
@@ -315,10 +339,10 @@ __device__ C output_layer(const A (&x)[kHiddenSteps], const Shared& sh, const fl
   C y;
   bias_tiles(&y, 1, bias, l);
 #pragma unroll
-  for (int kb = 0; kb < kHiddenSteps; ++kb) {
-    uint32_t b0, b1;
-    b_forward(sh.w2, kHiddenStride, 0, kb * 16, l, b0, b1);
-    mma(y, x[kb], b0, b1);
+  for (int kb = 0; kb < kHiddenSteps; kb += 2) {
+    const Fragments f = b_forward_steps(sh.w2, kHiddenStride, 0, kb * 16);
+    mma(y, x[kb], f.b[0], f.b[1]);
+    mma(y, x[kb + 1], f.b[2], f.b[3]);
   }
   return y;
 }
@@ -327,12 +351,7 @@ __device__ C output_layer(const A (&x)[kHiddenSteps], const Shared& sh, const fl
 // layer's W [outputs × 64]: the gradient of the last hidden activations.
 __device__ void output_backward(C (&out)[kHiddenBlocks], const A& g, const Shared& sh, Lane l) {
   bias_tiles(out, kHiddenBlocks, nullptr, l);
-#pragma unroll
-  for (int nb = 0; nb < kHiddenBlocks; ++nb) {
-    uint32_t b0, b1;
-    b_backward(sh.w2, kHiddenStride, nb * 8, 0, b0, b1);
-    mma(out[nb], g, b0, b1);
-  }
+  backward_tiles(out, g, sh.w2, kHiddenStride, 0);
 }
 
 // Writes C tile rows r0+g and r0+g+8, columns c and c+1, where they exist.
@@ -432,13 +451,17 @@ __device__ __forceinline__ void pack_tiles(A (&a)[kHiddenSteps], const C (&c)[kH
 __device__ void hidden_backward(C (&out)[kHiddenBlocks], const A (&g)[kHiddenSteps], const Shared& sh, Lane l) {
   bias_tiles(out, kHiddenBlocks, nullptr, l);
 #pragma unroll
-  for (int kb = 0; kb < kHiddenSteps; ++kb) {
+  for (int kb = 0; kb < kHiddenSteps; ++kb) backward_tiles(out, g[kb], sh.w1, kHiddenStride, kb * 16);
+}
+
+// Output tiles n0 and n0+8 of g·W for a gradient g over the hidden width (an input's gradient).
+__device__ __forceinline__ void input_tiles(C (&c)[2], const A (&g)[kHiddenSteps], const Bits* w, int ld, int n0) {
+  c[0] = c[1] = C{{0, 0, 0, 0}};
 #pragma unroll
-    for (int nb = 0; nb < kHiddenBlocks; ++nb) {
-      uint32_t b0, b1;
-      b_backward(sh.w1, kHiddenStride, nb * 8, kb * 16, b0, b1);
-      mma(out[nb], g[kb], b0, b1);
-    }
+  for (int kb = 0; kb < kHiddenSteps; ++kb) {
+    const Fragments f = b_backward_tiles(w, ld, n0, kb * 16);
+    mma(c[0], g[kb], f.b[0], f.b[1]);
+    mma(c[1], g[kb], f.b[2], f.b[3]);
   }
 }
 
@@ -526,20 +549,14 @@ __global__ void __launch_bounds__(kThreads)
         // The derivatives' gradient: frag · W_axis, 16 columns.
         const Bits* wa = sh.wa + axis * kHidden * kNarrowStride;
         __nv_bfloat16* gd = grad_derivatives + int64_t(axis) * n * s.derivative_width;
+        C c[2];
+        input_tiles(c, frag, wa, kNarrowStride, 0);
 #pragma unroll
-        for (int nb = 0; nb < 2; ++nb) {
-          C c{{0, 0, 0, 0}};
-#pragma unroll
-          for (int kb = 0; kb < kHiddenSteps; ++kb) {
-            uint32_t b0, b1;
-            b_backward(wa, kNarrowStride, nb * 8, kb * 16, b0, b1);
-            mma(c, frag[kb], b0, b1);
-          }
-          for_tile(c, r0, nb * 8, l, [&](int64_t r, int f, float lo, float hi) {
+        for (int nb = 0; nb < 2; ++nb)
+          for_tile(c[nb], r0, nb * 8, l, [&](int64_t r, int f, float lo, float hi) {
             if (r < n && f < s.derivative_width)
               *reinterpret_cast<__nv_bfloat162*>(gd + r * s.derivative_width + f) = __floats2bfloat162_rn(lo, hi);
           });
-        }
       }
     }
     pack_tiles(frag, gz1, identity);
@@ -552,25 +569,21 @@ __global__ void __launch_bounds__(kThreads)
     pack_tiles(frag, acc, identity);
     store_tiles(p.first_gradients, n, r0, frag, l);
     // The encoding's and condition's gradients: frag · W0.
-    for (int nb = 0; nb < lay.first_width / 8; ++nb) {
-      C c{{0, 0, 0, 0}};
-#pragma unroll
-      for (int kb = 0; kb < kHiddenSteps; ++kb) {
-        uint32_t b0, b1;
-        b_backward(sh.w0, lay.first_stride, nb * 8, kb * 16, b0, b1);
-        mma(c, frag[kb], b0, b1);
-      }
-      for_tile(c, r0, nb * 8, l, [&](int64_t r, int column, float lo, float hi) {
-        if (r >= n) return;
-        if (column < lay.encoding_steps_width) {
-          if (column < s.encoding_width)
-            *reinterpret_cast<__nv_bfloat162*>(grad_encoding + r * s.encoding_width + column) =
-                __floats2bfloat162_rn(lo, hi);
-        } else {
-          *reinterpret_cast<float2*>(grad_condition + r * s.condition_channels + column - lay.encoding_steps_width) =
-              make_float2(lo, hi);
-        }
-      });
+    for (int pair = 0; pair < lay.first_width / 16; ++pair) {  // first_width: a multiple of 16
+      C c[2];
+      input_tiles(c, frag, sh.w0, lay.first_stride, pair * 16);
+      for (int nb = 0; nb < 2; ++nb)
+        for_tile(c[nb], r0, pair * 16 + nb * 8, l, [&](int64_t r, int column, float lo, float hi) {
+          if (r >= n) return;
+          if (column < lay.encoding_steps_width) {
+            if (column < s.encoding_width)
+              *reinterpret_cast<__nv_bfloat162*>(grad_encoding + r * s.encoding_width + column) =
+                  __floats2bfloat162_rn(lo, hi);
+          } else {
+            *reinterpret_cast<float2*>(grad_condition + r * s.condition_channels + column - lay.encoding_steps_width) =
+                make_float2(lo, hi);
+          }
+        });
     }
   }
 }
