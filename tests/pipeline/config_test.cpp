@@ -76,6 +76,29 @@ TEST(PipelineConfig, ATrainStageMayTakeSeveralGpusAJob) {
         << bad;
 }
 
+TEST(PipelineConfig, AGpuStageMayShareEachGpuAmongSomeOfItsJobs) {
+  const StageGraph graph(parse("workspace: ws\nstages:\n  synth: {kind: synth_raw}\n  calibrate: {after: synth}\n"
+                               "  mvs: {after: calibrate, jobs_per_gpu: 3}\n"),
+                         all_commands);
+  EXPECT_EQ(graph.stages()[2].config->jobs_per_gpu, 3);
+  EXPECT_EQ(graph.stages()[1].config->jobs_per_gpu, 1);
+  EXPECT_NE(error_of([] { parse("workspace: ws\nstages:\n  mvs: {jobs_per_gpu: 0}\n"); })
+                .find("stages.mvs.jobs_per_gpu must be a whole number of jobs, at least 1"),
+            std::string::npos);
+  EXPECT_NE(error_of([] {
+              StageGraph(parse("workspace: ws\nstages:\n  synth: {kind: synth_raw}\n"
+                               "  calibrate: {after: synth, jobs_per_gpu: 2}\n"),
+                         all_commands);
+            }).find("stage 'calibrate': jobs_per_gpu: a calibrate shard runs on the CPU"),
+            std::string::npos);
+  EXPECT_NE(error_of([] {
+              StageGraph(parse("workspace: ws\nstages:\n  synth:\n  train: {after: synth, gpus_per_job: 2, "
+                               "jobs_per_gpu: 2}\n"),
+                         all_commands);
+            }).find("jobs_per_gpu and gpus_per_job together"),
+            std::string::npos);
+}
+
 // The key of each stage's shard: what its outputs depend on, and nothing else.
 std::map<std::string, std::string> shard_keys(const std::string& stages) {
   const StageGraph graph(parse("workspace: ws\nstages:\n  synth: {kind: synth_raw}\n"
@@ -96,9 +119,10 @@ TEST(Fingerprint, HoldsTheSplitsAndGpusThatChangeOutputsAndNoOthers) {
   EXPECT_NE(plain.at("track"), split.at("track")) << "each range's first frame is fitted afresh";
   EXPECT_NE(plain.at("train"), split.at("train")) << "four GPUs see four views a step";
   EXPECT_EQ(plain.at("dataset"), split.at("dataset"));  // the upstream hash stands for track's outputs here
-  const auto meshes_in_jobs = shard_keys("  mvs2: {kind: mvs, after: calibrate, frames_per_job: 5}\n");
+  const auto meshes_in_jobs =
+      shard_keys("  mvs2: {kind: mvs, after: calibrate, frames_per_job: 5, jobs_per_gpu: 3}\n");
   const auto meshes_whole = shard_keys("  mvs2: {kind: mvs, after: calibrate}\n");
-  EXPECT_EQ(meshes_in_jobs.at("mvs2"), meshes_whole.at("mvs2")) << "split meshes are the same bytes";
+  EXPECT_EQ(meshes_in_jobs.at("mvs2"), meshes_whole.at("mvs2")) << "split and GPU-sharing meshes are the same bytes";
 }
 
 TEST(PipelineConfig, OptionsAreCanonicalWhateverTheirOrderAndLayout) {
@@ -153,7 +177,7 @@ TEST(PipelineConfig, UnknownKeysAreErrorsNamingTheFileAndTheKnownKeys) {
             "/cfg/p.yaml: unknown key 'stage' (line 2); known keys: description, workspace, subjects, stages, gpus");
   EXPECT_EQ(error_of([] { parse("workspace: ws\nstages:\n  synth: {option: {}}\n"); }),
             "/cfg/p.yaml: unknown key 'stages.synth.option' (line 3); known keys of 'stages.synth': kind, after, "
-            "options, options_file, frames_per_job, gpus_per_job");
+            "options, options_file, frames_per_job, gpus_per_job, jobs_per_gpu");
   EXPECT_NE(error_of([] { parse("workspace: ws\nsubjects: {a: {options: {trian: {}}}}\nstages: {train: }\n"); })
                 .find("'subjects.a.options.trian' names no stage"),
             std::string::npos);

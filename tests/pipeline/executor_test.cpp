@@ -167,6 +167,42 @@ TEST(LocalExecutor, AJobWaitingForSeveralGpusIsNotOvertakenByLaterOnes) {
   for (const auto& r : results) EXPECT_TRUE(r.succeeded) << r.id << ": " << r.failure;
 }
 
+// Records the job's GPU in <id>.gpu and runs on it, failing when more than `most` jobs (its own
+// included) are on that GPU at either of two moments; `then` runs between them.
+std::string on_shared_gpu(const std::string& id, int most, const std::string& then = "sleep 0.1") {
+  const std::string mine = "running-$CUDA_VISIBLE_DEVICES-" + id;
+  const std::string check =
+      "[ $(ls running-$CUDA_VISIBLE_DEVICES-* | wc -l) -le " + std::to_string(most) + " ] || exit 3";
+  return "echo $CUDA_VISIBLE_DEVICES > " + id + ".gpu; touch " + mine + "; sleep 0.1; " + check + "; " + then +
+         "; " + check + "; rm " + mine;
+}
+
+TEST(LocalExecutor, JobsThatShareAGpuRunUpToTheirBoundOnTheLeastBusyGpu) {
+  test::TempDir dir;
+  const ScopedEnvironment machine("CUDA_VISIBLE_DEVICES", "0,1");
+  LocalExecutor executor(1, {"0", "1"});
+  const auto sharing = [&](const std::string& id, int jobs_per_gpu, const std::string& script) {
+    Job job = shell_job(id, script, dir, "cuda");
+    job.resources.jobs_per_gpu = jobs_per_gpu;
+    return job;
+  };
+  // a to d, two a GPU, only succeed when all four run at once; then e waits for room beside two,
+  // and alone, which takes a GPU by itself, waits for an idle one and keeps others off it.
+  const std::string all_four = "touch $0.started; i=0; while [ $(ls *.started | wc -l) -lt 4 ]; do i=$((i+1)); "
+                               "[ $i -gt 300 ] && exit 4; sleep 0.01; done";
+  for (const char* id : {"a", "b", "c", "d"}) {
+    Job job = sharing(id, 2, on_shared_gpu(id, 2, all_four));
+    job.argv.push_back(id);  // $0 of the script
+    executor.submit(job);
+  }
+  executor.submit(sharing("alone", 1, on_shared_gpu("alone", 1)));
+  executor.submit(sharing("e", 2, on_shared_gpu("e", 2)));
+  const auto results = wait_for_all(executor, 30s);
+  ASSERT_EQ(results.size(), 6u);
+  for (const auto& r : results) EXPECT_TRUE(r.succeeded) << r.id << ": " << r.failure;
+  EXPECT_NE(gpu_seen(dir, "a"), gpu_seen(dir, "b")) << "b shares a GPU while the other is idle";
+}
+
 TEST(LocalExecutor, WithoutGpusRunsCudaJobsOneAtATimeUnpinned) {
   test::TempDir dir;
   const ScopedEnvironment machine("CUDA_VISIBLE_DEVICES", "5,6");

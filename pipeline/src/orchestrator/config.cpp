@@ -135,7 +135,8 @@ StageConfig read_stage(const Reader& r, const std::string& name, const YAML::Nod
   stage.kind = name;
   if (node.IsNull()) return stage;
   r.require_map(node, where);
-  r.check_keys(node, where, {"kind", "after", "options", "options_file", "frames_per_job", "gpus_per_job"});
+  r.check_keys(node, where, {"kind", "after", "options", "options_file", "frames_per_job", "gpus_per_job",
+                                  "jobs_per_gpu"});
   if (node["kind"]) stage.kind = r.scalar(node["kind"], where + ".kind");
   // A whole number of at least `least`; else an error saying what the key must be.
   const auto whole_number = [&](const char* key, int least, const std::string& meaning) {
@@ -149,6 +150,8 @@ StageConfig read_stage(const Reader& r, const std::string& name, const YAML::Nod
     stage.frames_per_job = whole_number("frames_per_job", 0, "a whole number of frames, 0 for one job");
   if (node["gpus_per_job"])
     stage.gpus_per_job = whole_number("gpus_per_job", 1, "a whole number of GPUs, at least 1");
+  if (node["jobs_per_gpu"])
+    stage.jobs_per_gpu = whole_number("jobs_per_gpu", 1, "a whole number of jobs, at least 1");
   if (node["after"]) stage.after = r.string_list(node["after"], where + ".after");
   YAML::Node options;
   if (node["options_file"]) {

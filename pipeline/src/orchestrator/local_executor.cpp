@@ -26,6 +26,11 @@ namespace {
 
 constexpr auto kPollInterval = std::chrono::milliseconds(20);
 
+// A job of several GPUs holds them alone.
+int jobs_sharing_a_gpu(const Resources& resources) {
+  return resources.gpu_count > 1 ? 1 : std::max(1, resources.jobs_per_gpu);
+}
+
 std::string describe_exit(int status) {
   if (WIFEXITED(status)) return "exit code " + std::to_string(WEXITSTATUS(status));
   if (WIFSIGNALED(status)) return std::string("killed by signal ") + std::to_string(WTERMSIG(status)) + " (" +
@@ -107,23 +112,34 @@ pid_t LocalExecutor::launch(const Job& job, const std::string& pinned) {
 }
 
 std::optional<LocalExecutor::Held> LocalExecutor::free_gpus(const Job& job) const {
-  const auto held = [&](const std::string& gpu) {
-    return std::any_of(running_.begin(), running_.end(), [&](const auto& r) {
-      const auto& gpus = r.second.held.gpus;
-      return std::find(gpus.begin(), gpus.end(), gpu) != gpus.end();
-    });
+  // The jobs on `gpu` now, or nullopt when `job` may not join them: a GPU runs at most as many jobs
+  // as the strictest of their jobs_per_gpu and the job's own allow.
+  const auto jobs_beside = [&](const std::string& gpu) -> std::optional<int> {
+    int jobs = 0, bound = jobs_sharing_a_gpu(job.resources);
+    for (const auto& [pid, r] : running_) {
+      const auto& gpus = r.held.gpus;
+      if (std::find(gpus.begin(), gpus.end(), gpu) == gpus.end()) continue;
+      ++jobs;
+      bound = std::min(bound, jobs_sharing_a_gpu(r.job.resources));
+    }
+    if (jobs >= bound) return std::nullopt;
+    return jobs;
   };
   const std::string& device = job.resources.gpu_device;
   if (device == "cuda" && !gpus_.empty()) {
     const size_t wanted = size_t(std::max(1, job.resources.gpu_count));
+    // The least busy GPUs first, so that shared ones fill only when none is idle.
+    std::vector<std::pair<int, size_t>> open;  // (jobs on it, index in gpus_)
+    for (size_t i = 0; i < gpus_.size(); ++i)
+      if (const auto jobs = jobs_beside(gpus_[i])) open.emplace_back(*jobs, i);
+    if (open.size() < wanted) return std::nullopt;
+    std::stable_sort(open.begin(), open.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     Held free{{}, true};
-    for (const std::string& gpu : gpus_)
-      if (!held(gpu) && free.gpus.size() < wanted) free.gpus.push_back(gpu);
-    if (free.gpus.size() < wanted) return std::nullopt;
+    for (size_t k = 0; k < wanted; ++k) free.gpus.push_back(gpus_[open[k].second]);
     return free;
   }
   const std::string gpu = device.rfind("cuda:", 0) == 0 ? device.substr(5) : device;
-  if (held(gpu)) return std::nullopt;
+  if (!jobs_beside(gpu)) return std::nullopt;
   return Held{{gpu}, false};
 }
 

@@ -214,6 +214,7 @@ class Run {
     if (!stage.kind->device_option.empty()) {
       device = scalar_option(s.fingerprint.options_yaml, stage.kind->device_option);
       if (device && device->rfind("cuda", 0) == 0) job.resources.gpu_device = *device;
+      job.resources.jobs_per_gpu = stage.config->jobs_per_gpu;
     }
     if (const int gpus = stage.config->gpus_per_job; gpus > 1) {
       if (job.resources.gpu_device != "cuda")

@@ -66,6 +66,13 @@ StageGraph::StageGraph(PipelineConfig config, const CommandAvailable& available)
       throw Error(source, "stage '" + sc.name + "': gpus_per_job: a " + stage.kind->name +
                               " shard runs on one GPU (only train spreads a shard over several)");
     }
+    if (sc.jobs_per_gpu > 1 && stage.kind->device_option.empty()) {
+      throw Error(source, "stage '" + sc.name + "': jobs_per_gpu: a " + stage.kind->name + " shard runs on the CPU");
+    }
+    if (sc.jobs_per_gpu > 1 && sc.gpus_per_job > 1) {
+      throw Error(source, "stage '" + sc.name + "': jobs_per_gpu and gpus_per_job together: a job of several GPUs "
+                              "holds them alone");
+    }
     for (const auto& up : sc.after) {
       const auto it = by_name.find(up);
       if (it == by_name.end()) throw Error(source, "stage '" + sc.name + "': 'after' names no stage: '" + up + "'");

@@ -23,6 +23,9 @@ struct StageConfig {
   // `gpus_per_job: N`: each shard runs on N GPUs at once (kinds with StageKind::gpus_flag only:
   // train, data parallel), with the stage's device `cuda`; 1: one GPU, as any GPU stage.
   int gpus_per_job = 1;
+  // `jobs_per_gpu: K`: up to K of this stage's jobs share one GPU in a local run (GPU stages
+  // only; not with gpus_per_job), so that one job's GPU work overlaps another's CPU work.
+  int jobs_per_gpu = 1;
   // `options_file` (a file in the command's own --config format) with
   // `options` merged over it; canonical YAML, "" = none.
   std::string options_yaml;

@@ -15,11 +15,16 @@ namespace tega::pipeline {
 struct Resources {
   // "" for a CPU job; else the GPU device it uses. "cuda": any one GPU, which the executor
   // chooses (the local one pins the job to it with CUDA_VISIBLE_DEVICES); "cuda:1": that
-  // device, as the machine numbers it. A GPU runs one job at a time.
+  // device, as the machine numbers it. A GPU runs one job at a time unless jobs_per_gpu says more.
   std::string gpu_device;
   // GPUs a "cuda" job holds at once (a train shard of `gpus_per_job: N`): the local executor pins
   // it to that many free GPUs (CUDA_VISIBLE_DEVICES=a,b,...), Slurm asks for them (--gres=gpu:N).
   int gpu_count = 1;
+  // Jobs one GPU runs at once while this job is among them (the local executor; each job's own
+  // bound holds, and a job of several GPUs holds them alone). A stage's `jobs_per_gpu`: for jobs
+  // that leave their GPU idle much of the time, as mvs's do while they build surfaces on the CPU.
+  // Slurm gives every job GPUs of its own.
+  int jobs_per_gpu = 1;
 };
 
 struct Job {

@@ -1,12 +1,13 @@
 #pragma once
 // Runs jobs as child processes of this one: up to `cpu_slots` CPU jobs at
-// once, and one job at a time per GPU. A job for "cuda" runs on whichever GPU
-// of `gpus` is free, pinned to it with CUDA_VISIBLE_DEVICES (so it sees that
-// GPU alone, as its device 0); one of gpu_count N > 1 waits for N free GPUs
+// once, and one job at a time per GPU, or up to the jobs' jobs_per_gpu
+// (Resources). A job for "cuda" runs on the least busy GPU of `gpus` that has
+// room, pinned to it with CUDA_VISIBLE_DEVICES (so it sees that GPU alone, as
+// its device 0); one of gpu_count N > 1 waits for N free GPUs
 // and is pinned to all of them (its devices 0 to N-1). Such jobs start in
 // queue order: a later one never takes a GPU that an earlier one waits for.
-// With no `gpus` they run one at a time, unpinned. A job for "cuda:N" runs on
-// device N, unpinned, when no other job holds N. Children die with the
+// With no `gpus` they run unpinned, one at a time (or jobs_per_gpu). A job for
+// "cuda:N" runs on device N, unpinned, when N has room. Children die with the
 // orchestrator (PR_SET_PDEATHSIG), even when it is killed with SIGKILL, so no
 // orphan keeps writing into a workspace that a new run is cleaning up.
 //
