@@ -70,7 +70,7 @@ void render_calibration(const Studio& studio, const std::string& take) {
                       }};
     const ImageF fg = rasterize(cameras[c], {printed, unprinted}, studio.options.supersampling);
     const uint64_t noise = hash_of(uint64_t(studio.options.seed), hash_string(take.c_str()), c, f);
-    write_image(capture_image(&fg, studio.backgrounds[c], noise, studio.options.noise_sigma), studio.root / "takes" / take / cameras[c].name / (frame_name(f) + ".png"));
+    write_studio_image(capture_image(&fg, studio.backgrounds[c], noise, studio.options.noise_sigma), studio.root / "takes" / take / cameras[c].name / (frame_name(f) + ".png"));
     studio.progress.advance();
   });
 

@@ -12,7 +12,7 @@ void render_clean_plate(const Studio& studio) {
   studio.pool.parallel_for(0, cameras, [&](int64_t c) {
     const Camera& cam = studio.rig.cameras[c];
     const uint64_t noise = hash_of(uint64_t(studio.options.seed), hash_string(take.c_str()), c, 0);
-    write_image(capture_image(nullptr, studio.backgrounds[c], noise, studio.options.noise_sigma), studio.root / "takes" / take / cam.name / (frame_name(0) + ".png"));
+    write_studio_image(capture_image(nullptr, studio.backgrounds[c], noise, studio.options.noise_sigma), studio.root / "takes" / take / cam.name / (frame_name(0) + ".png"));
     studio.progress.advance();
   });
   write_take_json(studio, take, "clean_plate", 1);

@@ -74,4 +74,11 @@ void write_take_json(const Studio& studio, const std::string& take, const std::s
   write_take(info, studio.root / "takes" / take);
 }
 
+void write_studio_image(const Image8& image, const std::filesystem::path& file) {
+  if (file.extension() != ".png") return write_image(image, file);
+  write_png_view({image.pixels.data(), image.width, image.height, image.channels, 8,
+                  size_t(image.width) * image.channels},
+                 file, 1);
+}
+
 }  // namespace tega::synth

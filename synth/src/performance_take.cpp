@@ -142,10 +142,10 @@ void render_performance(const Studio& studio, const std::string& take, const Dat
       const ImageF pinhole = rasterize(dataset.rig.cameras[c], {head}, o.supersampling);
       const ImageF captured = resample_through_lens(pinhole, studio.lens[c]);
       const std::string name = frame_name(f);
-      write_image(capture_image(&captured, studio.backgrounds[c], noise, o.noise_sigma),
+      write_studio_image(capture_image(&captured, studio.backgrounds[c], noise, o.noise_sigma),
                   studio.root / "takes" / take / cameras[c].name / (name + ".png"));
-      write_image(alpha_image(captured), gt / "alpha" / cameras[c].name / (name + ".png"));
-      write_image(matte_image(pinhole, noise, o.noise_sigma), dataset.image_path(cameras[c].name, take + "_" + name));
+      write_studio_image(alpha_image(captured), gt / "alpha" / cameras[c].name / (name + ".png"));
+      write_studio_image(matte_image(pinhole, noise, o.noise_sigma), dataset.image_path(cameras[c].name, take + "_" + name));
       studio.progress.advance();
     });
 
