@@ -82,6 +82,39 @@ TEST(AblationStudy, TrainsEveryRowAndSeedThenTabulatesAndInspectsThem) {
   EXPECT_EQ(inspected.at(1).at("run").get<std::string>(), (tmp / "study/runs/full.s1").string());
 }
 
+// Table 1 on a dataset made elsewhere (the raw chain's, in a real study), scored against the
+// truth of the capture it came from, or not scored without one.
+TEST(AblationStudy, TrainsOnAGivenDatasetAndInspectsAgainstAGivenTruth) {
+  if (!tega_trains()) GTEST_SKIP() << "this tega has no train command (no libtorch)";
+  TempDir tmp;
+  const auto rendered = run_tega("synth --config " + std::string(TEGA_SOURCE_DIR) +
+                                 "/studio_configs/ablation-capture.yaml --set self_shadowing.map_size=256 --out " +
+                                 (tmp / "elsewhere").string() + " --force --width 96 --height 64 --frames 3");
+  ASSERT_EQ(rendered.exit_code, 0) << rendered.output;
+  const std::string given = tiny_study_environment(tmp) + "VARIANTS=full SEEDS=0 CURVE=1 DATASET=" +
+                            (tmp / "elsewhere/dataset").string() + " ";
+
+  const auto scored = run_command(given + "TRUTH=" + (tmp / "elsewhere").string() + " bash " + kScript + " " +
+                                  (tmp / "study").string());
+  ASSERT_EQ(scored.exit_code, 0) << scored.output;
+  EXPECT_FALSE(std::filesystem::exists(tmp / "study/capture")) << "nothing rendered";
+  EXPECT_NE(read_text_file(tmp / "study/runs/full.s0/run.json").find((tmp / "elsewhere/dataset").string()),
+            std::string::npos);
+  EXPECT_NE(read_text_file(tmp / "study/liveness.md").find("## full.s0"), std::string::npos);
+
+  const auto unscored = run_command(given + "bash " + kScript + " " + (tmp / "unscored").string());
+  ASSERT_EQ(unscored.exit_code, 0) << unscored.output;
+  EXPECT_NE(unscored.output.find("no TRUTH to inspect the runs against; liveness skipped"), std::string::npos)
+      << unscored.output;
+  EXPECT_TRUE(std::filesystem::exists(tmp / "unscored/table.md"));
+  EXPECT_FALSE(std::filesystem::exists(tmp / "unscored/liveness.md"));
+
+  const auto missing = run_command(given + "DATASET=" + (tmp / "nowhere").string() + " bash " + kScript + " " +
+                                   (tmp / "missing").string());
+  EXPECT_EQ(missing.exit_code, 1) << missing.output;
+  EXPECT_NE(missing.output.find("DATASET: no dataset at"), std::string::npos) << missing.output;
+}
+
 TEST(AblationStudy, ARowOfTheRowsFileMustBeNewAndWellNamed) {
   TempDir tmp;
   const std::string study = "VARIANTS='full' bash " + kScript + " " + (tmp / "study").string();

@@ -83,7 +83,13 @@ class TrueMeshes {
       const std::string slot = "{frame:06d}";
       if (coarse.find(slot) == std::string::npos) throw Error(file, "no coarse mesh pattern with " + slot);
       coarse.replace(coarse.find(slot), slot.size(), number);
-      return {read_vertices_bin(file.parent_path() / coarse, vertices), RigidTransform::from_matrix(pose)};
+      const std::filesystem::path mesh = file.parent_path() / coarse;
+      Vertices true_vertices = read_vertices_bin(mesh);
+      if (true_vertices.rows() != vertices)
+        throw Error(mesh, "has " + std::to_string(true_vertices.rows()) + " vertices, the dataset's meshes " +
+                              std::to_string(vertices) + ": --truth needs a dataset in the studio's own template "
+                              "(tega synth's), not meshes tracked with the head model");
+      return {std::move(true_vertices), RigidTransform::from_matrix(pose)};
     }
     throw Error(file, "no frame " + number + " (dataset frame '" + f.id + "')");
   }
