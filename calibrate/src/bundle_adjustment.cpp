@@ -2,9 +2,8 @@
 #include <ceres/manifold.h>
 #include <ceres/rotation.h>
 
-#include <thread>
-
 #include "calibration_state.h"
+#include "tega/core/thread_pool.h"
 
 namespace tega::calibrate::detail {
 
@@ -75,7 +74,7 @@ void bundle_adjust(CalibrationState& state, const Board& board, const Calibratio
   solver.max_num_iterations = 200;
   solver.function_tolerance = 1e-10;
   solver.parameter_tolerance = 1e-10;
-  solver.num_threads = options.threads > 0 ? options.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+  solver.num_threads = options.threads > 0 ? options.threads : default_thread_count();
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem, &summary);
 }

@@ -92,7 +92,7 @@ BlendshapeModel BlendshapeModel::load_directory(const fs::path& directory, doubl
   files.insert(files.end(), expression_files.begin(), expression_files.end());
   std::vector<Vertices> deltas(files.size());
   // Each shape is a full mesh of a few MB of text: parsing dominates loading.
-  ThreadPool pool(static_cast<int>(std::min<size_t>(files.size(), std::thread::hardware_concurrency())));
+  ThreadPool pool(static_cast<int>(std::min<size_t>(files.size(), size_t(default_thread_count()))));
   pool.parallel_for(0, static_cast<int64_t>(files.size()), [&](int64_t i) {
     const fs::path& file = files[i];
     Mesh shape = read_obj(file);

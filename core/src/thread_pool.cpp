@@ -2,12 +2,25 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdlib>
 #include <exception>
+#include <string>
+
+#include "tega/core/error.h"
 
 namespace tega {
 
+int default_thread_count() {
+  const char* set = std::getenv("TEGA_THREADS");
+  if (set == nullptr || *set == '\0') return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const std::string text = set;
+  if (text.size() > 6 || text.find_first_not_of("0123456789") != std::string::npos || std::stoi(text) < 1)
+    throw Error("TEGA_THREADS must be a whole number of threads, at least 1 (it is '" + text + "')");
+  return std::stoi(text);
+}
+
 ThreadPool::ThreadPool(int threads) {
-  if (threads <= 0) threads = std::max(1u, std::thread::hardware_concurrency());
+  if (threads <= 0) threads = default_thread_count();
   workers_.reserve(threads);
   for (int i = 0; i < threads; ++i) workers_.emplace_back([this] { work(); });
 }

@@ -3,10 +3,10 @@
 
 #include <iostream>
 #include <string>
-#include <thread>
 
 #include "dlib_conversions.h"
 #include "mirroring.h"
+#include "tega/core/thread_pool.h"
 #include "tega/core/error.h"
 #include "tega/core/files.h"
 #include "tega/landmarks/landmarks.h"
@@ -56,7 +56,7 @@ class ProgressToStderr {
 };
 
 int worker_threads(int requested) {
-  return requested > 0 ? requested : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  return requested > 0 ? requested : default_thread_count();
 }
 
 }  // namespace

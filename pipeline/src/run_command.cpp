@@ -6,10 +6,10 @@
 #include <iostream>
 #include <memory>
 #include <optional>
-#include <thread>
 
 #include "available_commands.h"
 #include "commands.h"
+#include "tega/core/thread_pool.h"
 #include "tega/core/error.h"
 #include "tega/core/log.h"
 #include "tega/pipeline/gpus.h"
@@ -75,7 +75,7 @@ std::unique_ptr<pipeline::Executor> make_executor(const RunArguments& args, cons
   for (const char* slurm_only : {"--partition", "--gpus-per-job", "--max-requeues"}) {
     if (cmd.count(slurm_only) > 0) throw Error(std::string(slurm_only) + " applies to --executor slurm only");
   }
-  const int jobs = args.jobs > 0 ? args.jobs : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int jobs = args.jobs > 0 ? args.jobs : default_thread_count();
   std::vector<std::string> gpus = local_gpus(args, config);
   if (!gpus.empty()) {
     std::string listed;

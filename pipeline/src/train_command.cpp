@@ -1,11 +1,11 @@
 #include <iostream>
 #include <memory>
 #include <optional>
-#include <thread>
 
 #include "commands.h"
 #include "stage_options.h"
 #include "train_processes.h"
+#include "tega/core/thread_pool.h"
 #include "tega/core/error.h"
 #include "tega/core/log.h"
 #include "tega/core/options.h"
@@ -111,7 +111,7 @@ void add_train_command(CLI::App& app) {
     if (const auto rank = parallel_rank_from_environment()) {
       control.parallel = *rank;
       if (options.device == "cpu" && options.cpu_threads == 0)  // the cores shared out, not each taken by all
-        options.cpu_threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / rank->world);
+        options.cpu_threads = std::max(1, default_thread_count() / rank->world);
     }
     const auto s = trainer::train(args->data, args->out, options, control);
     if (control.parallel.rank > 0) return;

@@ -5,10 +5,12 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cstdlib>
 #include <chrono>
 #include <numeric>
 #include <thread>
 
+#include "tega/core/error.h"
 #include "tega/core/log.h"
 #include "tega/core/progress.h"
 
@@ -32,6 +34,27 @@ TEST(ThreadPool, ParallelForRethrowsTheFirstError) {
   std::atomic<int64_t> sum{0};
   pool.parallel_for(0, 10, [&](int64_t i) { sum += i; });
   EXPECT_EQ(sum.load(), 45);
+}
+
+TEST(ThreadPool, ThreadsLeftToTheDefaultAreTegaThreadsWhereItIsSet) {
+  const char* before = std::getenv("TEGA_THREADS");
+  const std::string saved = before ? before : "";
+  ::setenv("TEGA_THREADS", "3", 1);
+  EXPECT_EQ(tega::default_thread_count(), 3);
+  EXPECT_EQ(tega::ThreadPool().size(), 3);
+  for (const char* bad : {"0", "-2", "many", "4 "}) {
+    ::setenv("TEGA_THREADS", bad, 1);
+    try {
+      tega::default_thread_count();
+      ADD_FAILURE() << bad << " was taken";
+    } catch (const tega::Error& e) {
+      EXPECT_NE(std::string(e.what()).find("TEGA_THREADS must be a whole number of threads, at least 1"),
+                std::string::npos);
+    }
+  }
+  ::unsetenv("TEGA_THREADS");
+  EXPECT_EQ(tega::default_thread_count(), int(std::max(1u, std::thread::hardware_concurrency())));
+  if (before) ::setenv("TEGA_THREADS", saved.c_str(), 1);
 }
 
 TEST(ThreadPool, SubmitReturnsResults) {

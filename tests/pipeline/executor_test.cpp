@@ -113,7 +113,7 @@ TEST(LocalExecutor, SpreadsCudaJobsOverItsGpusEachPinnedToOneOfThem) {
   for (const char* id : {"a", "b", "c", "d", "e"}) {
     const std::string gpu = gpu_seen(dir, id);
     EXPECT_TRUE(gpu == "2" || gpu == "GPU-7f3a") << id << " saw CUDA_VISIBLE_DEVICES=" << gpu;
-    EXPECT_NE(read_text_file(dir / ("logs/" + std::string(id) + ".log")).find(" on GPU " + gpu + ":"),
+    EXPECT_NE(read_text_file(dir / ("logs/" + std::string(id) + ".log")).find(" on GPU " + gpu + ", "),
               std::string::npos);
   }
 }
@@ -147,7 +147,7 @@ TEST(LocalExecutor, AJobOfSeveralGpusWaitsForThatManyFreeOnesAndIsPinnedToAllOfT
   EXPECT_EQ(pair.size(), 3u) << pair;  // two of the three, e.g. "0,1"
   EXPECT_EQ(pair.find(one), std::string::npos) << one << " is also in " << pair;
   EXPECT_EQ(gpu_seen(dir, "second_pair").size(), 3u);
-  EXPECT_NE(read_text_file(dir / "logs/pair.log").find(" on GPUs " + pair + ":"), std::string::npos);
+  EXPECT_NE(read_text_file(dir / "logs/pair.log").find(" on GPUs " + pair + ", "), std::string::npos);
 }
 
 TEST(LocalExecutor, AJobWaitingForSeveralGpusIsNotOvertakenByLaterOnes) {
@@ -201,6 +201,23 @@ TEST(LocalExecutor, JobsThatShareAGpuRunUpToTheirBoundOnTheLeastBusyGpu) {
   ASSERT_EQ(results.size(), 6u);
   for (const auto& r : results) EXPECT_TRUE(r.succeeded) << r.id << ": " << r.failure;
   EXPECT_NE(gpu_seen(dir, "a"), gpu_seen(dir, "b")) << "b shares a GPU while the other is idle";
+}
+
+TEST(LocalExecutor, JobsShareTheCoresAmongThoseRunning) {
+  test::TempDir dir;
+  const ScopedEnvironment orchestrator("OMP_NUM_THREADS", "64");  // replaced, not inherited
+  LocalExecutor executor(4, {}, std::chrono::seconds(5), /*cores=*/8);
+  const auto threads_seen = [](const std::string& id) { return "echo $TEGA_THREADS $OMP_NUM_THREADS > " + id + ".threads"; };
+  // Four at once share 8 cores, 2 threads each; then one alone has all of them.
+  for (const char* id : {"a", "b", "c", "d"})
+    executor.submit(shell_job(id, threads_seen(id) + "; " + rendezvous(std::string(id) + ".started", "d.started"), dir));
+  ASSERT_EQ(wait_for_all(executor, 20s).size(), 4u);
+  executor.submit(shell_job("alone", threads_seen("alone"), dir));
+  ASSERT_EQ(wait_for_all(executor, 20s).size(), 1u);
+  for (const char* id : {"a", "b", "c", "d"}) EXPECT_EQ(read_text_file(dir / (std::string(id) + ".threads")), "2 2\n");
+  EXPECT_EQ(read_text_file(dir / "alone.threads"), "8 8\n");
+  EXPECT_NE(read_text_file(dir / "logs/a.log").find("a, 2 threads: /bin/sh"), std::string::npos);
+  EXPECT_NE(read_text_file(dir / "logs/alone.log").find("alone, 8 threads: "), std::string::npos);
 }
 
 TEST(LocalExecutor, WithoutGpusRunsCudaJobsOneAtATimeUnpinned) {

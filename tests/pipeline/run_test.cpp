@@ -368,7 +368,7 @@ TEST(TegaRun, ATrainShardOfSeveralGpusIsPinnedToThatManyAndTrainsOnAllOfThem) {
   const auto r = run_tega({"run", (dir / "cuda.yaml").string(), "--gpus", "3,1,2"}, dir.path());
   EXPECT_NE(r.output.find("train/default started on 2 GPUs"), std::string::npos) << r.output;
   const std::string log = read_text_file(dir / "ws/logs/train/default.log");
-  EXPECT_NE(log.find("train/default on GPUs 3,1: "), std::string::npos) << log;
+  EXPECT_NE(log.find("train/default on GPUs 3,1, "), std::string::npos) << log;
   EXPECT_NE(log.find(" --gpus 0,1"), std::string::npos) << log;
 
   write_text(dir / "cpu.yaml", stages + "cpu}\n");

@@ -5,7 +5,8 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <set>
-#include <thread>
+
+#include "tega/core/thread_pool.h"
 
 namespace tega::tracking {
 namespace {
@@ -230,7 +231,7 @@ ceres::LossFunction* loss_of(const TermScale& scale, size_t count) {
 ceres::Solver::Options solver_options(int iterations, int threads, ceres::LinearSolverType solver) {
   ceres::Solver::Options o;
   o.max_num_iterations = iterations;
-  o.num_threads = threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
+  o.num_threads = threads > 0 ? threads : default_thread_count();
   o.linear_solver_type = solver;
   o.logging_type = ceres::SILENT;
   o.function_tolerance = 1e-7;

@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "tega/core/error.h"
+#include "tega/core/thread_pool.h"
 #include "tega/core/files.h"
 #include "tega/core/interrupt.h"
 #include "tega/core/log.h"
@@ -643,8 +644,7 @@ class Run {
 }  // namespace
 
 TrainSummary train(const fs::path& dataset, const fs::path& run, TrainOptions options, const RunControl& control) {
-  at::set_num_threads(options.cpu_threads > 0 ? options.cpu_threads
-                                              : static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+  at::set_num_threads(options.cpu_threads > 0 ? options.cpu_threads : default_thread_count());
   DataParallel parallel(control.parallel, at::Device(options.device));
   const bool has_checkpoint = fs::exists(run / kCheckpoint) || fs::exists(run / kPreviousCheckpoint);
   if (control.resume) {

@@ -16,6 +16,7 @@ extern char** environ;
 #include <thread>
 
 #include "tega/core/error.h"
+#include "tega/core/thread_pool.h"
 #include "tega/pipeline/manifest.h"
 
 namespace tega::pipeline {
@@ -38,13 +39,19 @@ std::string describe_exit(int status) {
   return "ended with wait status " + std::to_string(status);
 }
 
-// This process's environment with CUDA_VISIBLE_DEVICES set to `gpu` ("" leaves it as it is).
-std::vector<std::string> child_environment(const std::string& gpu) {
-  static constexpr std::string_view kVisible = "CUDA_VISIBLE_DEVICES=";
+// This process's environment with CUDA_VISIBLE_DEVICES set to `gpu` ("" leaves it as it is) and
+// the job's threads in TEGA_THREADS and OMP_NUM_THREADS.
+std::vector<std::string> child_environment(const std::string& gpu, int threads) {
+  static constexpr std::string_view kVisible = "CUDA_VISIBLE_DEVICES=", kThreads = "TEGA_THREADS=",
+                                    kOpenMp = "OMP_NUM_THREADS=";
+  const auto is = [](std::string_view entry, std::string_view name) { return entry.substr(0, name.size()) == name; };
   std::vector<std::string> environment;
   for (char** entry = environ; *entry != nullptr; ++entry)
-    if (gpu.empty() || std::string_view(*entry).substr(0, kVisible.size()) != kVisible) environment.push_back(*entry);
+    if (!(is(*entry, kVisible) && !gpu.empty()) && !is(*entry, kThreads) && !is(*entry, kOpenMp))
+      environment.push_back(*entry);
   if (!gpu.empty()) environment.push_back(std::string(kVisible) + gpu);
+  environment.push_back(std::string(kThreads) + std::to_string(threads));
+  environment.push_back(std::string(kOpenMp) + std::to_string(threads));
   return environment;
 }
 
@@ -80,26 +87,29 @@ std::vector<char*> null_terminated(const std::vector<std::string>& strings) {
 
 }  // namespace
 
-LocalExecutor::LocalExecutor(int cpu_slots, std::vector<std::string> gpus, std::chrono::milliseconds stop_grace)
-    : cpu_slots_(std::max(1, cpu_slots)), gpus_(std::move(gpus)), stop_grace_(stop_grace) {}
+LocalExecutor::LocalExecutor(int cpu_slots, std::vector<std::string> gpus, std::chrono::milliseconds stop_grace,
+                             int cores)
+    : cpu_slots_(std::max(1, cpu_slots)), cores_(cores > 0 ? cores : default_thread_count()), gpus_(std::move(gpus)),
+      stop_grace_(stop_grace) {}
 
 LocalExecutor::~LocalExecutor() { cancel_all(); }
 
 void LocalExecutor::submit(Job job) { queue_.push_back(std::move(job)); }
 
-pid_t LocalExecutor::launch(const Job& job, const std::string& pinned) {
+pid_t LocalExecutor::launch(const Job& job, const std::string& pinned, int threads) {
   fs::create_directories(job.log_file.parent_path());
   const int log_fd = ::open(job.log_file.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   if (log_fd < 0) throw Error(job.log_file, "cannot be opened for writing");
   const std::string on = pinned.empty() ? "" : (pinned.find(',') == std::string::npos ? " on GPU " : " on GPUs ") + pinned;
-  std::string header = "=== " + utc_now() + " " + job.id + on + ":";
+  std::string header = "=== " + utc_now() + " " + job.id + on + ", " + std::to_string(threads) +
+                       (threads == 1 ? " thread:" : " threads:");
   for (const auto& a : job.argv) header += " " + a;
   header += "\n";
   (void)!::write(log_fd, header.data(), header.size());
 
   // Built before fork: between fork and exec nothing may allocate.
   std::vector<char*> argv = null_terminated(job.argv);
-  const std::vector<std::string> environment = child_environment(pinned);
+  const std::vector<std::string> environment = child_environment(pinned, threads);
   std::vector<char*> envp = null_terminated(environment);
   const std::string directory = job.working_directory.string();
   const pid_t parent = ::getpid();
@@ -111,17 +121,18 @@ pid_t LocalExecutor::launch(const Job& job, const std::string& pinned) {
   return pid;
 }
 
-std::optional<LocalExecutor::Held> LocalExecutor::free_gpus(const Job& job) const {
-  // The jobs on `gpu` now, or nullopt when `job` may not join them: a GPU runs at most as many jobs
-  // as the strictest of their jobs_per_gpu and the job's own allow.
+std::optional<LocalExecutor::Held> LocalExecutor::free_gpus(const Job& job, const std::vector<Start>& starting) const {
+  // The jobs on `gpu` now (running or starting in this pass), or nullopt when `job` may not join
+  // them: a GPU runs at most as many jobs as the strictest of their jobs_per_gpu and the job's own allow.
   const auto jobs_beside = [&](const std::string& gpu) -> std::optional<int> {
     int jobs = 0, bound = jobs_sharing_a_gpu(job.resources);
-    for (const auto& [pid, r] : running_) {
-      const auto& gpus = r.held.gpus;
-      if (std::find(gpus.begin(), gpus.end(), gpu) == gpus.end()) continue;
+    const auto count = [&](const Held& held, const Resources& resources) {
+      if (std::find(held.gpus.begin(), held.gpus.end(), gpu) == held.gpus.end()) return;
       ++jobs;
-      bound = std::min(bound, jobs_sharing_a_gpu(r.job.resources));
-    }
+      bound = std::min(bound, jobs_sharing_a_gpu(resources));
+    };
+    for (const auto& [pid, r] : running_) count(r.held, r.job.resources);
+    for (const Start& s : starting) count(s.held, s.job.resources);
     if (jobs >= bound) return std::nullopt;
     return jobs;
   };
@@ -146,38 +157,43 @@ std::optional<LocalExecutor::Held> LocalExecutor::free_gpus(const Job& job) cons
 void LocalExecutor::start_ready_jobs(std::vector<JobResult>& results) {
   int cpu_running = 0;
   for (const auto& [pid, r] : running_) cpu_running += r.held.gpus.empty() ? 1 : 0;
+  // First which jobs start, then their share of the cores among all that will be running.
+  std::vector<Start> starting;
+  std::deque<Job> waiting;
   // Jobs for any of the run's GPUs start in queue order: a job waiting for several GPUs is not
   // starved by later ones that each take one as it frees.
   bool pooled_waiting = false;
-  for (auto it = queue_.begin(); it != queue_.end();) {
-    const bool cpu_job = it->resources.gpu_device.empty();
-    const bool pooled = it->resources.gpu_device == "cuda" && !gpus_.empty();
-    if (!cpu_job && !gpus_.empty() && it->resources.gpu_count > int(gpus_.size())) {
-      results.push_back({it->id, false,
-                         "could not start: it needs " + std::to_string(it->resources.gpu_count) +
+  for (Job& job : queue_) {
+    const bool cpu_job = job.resources.gpu_device.empty();
+    const bool pooled = job.resources.gpu_device == "cuda" && !gpus_.empty();
+    if (!cpu_job && !gpus_.empty() && job.resources.gpu_count > int(gpus_.size())) {
+      results.push_back({job.id, false,
+                         "could not start: it needs " + std::to_string(job.resources.gpu_count) +
                              " GPUs at once and this run has " + std::to_string(gpus_.size()) + " (tega run --gpus)",
                          0});
-      it = queue_.erase(it);
       continue;
     }
     std::optional<Held> gpus;
-    if (cpu_job ? cpu_running >= cpu_slots_ : (pooled && pooled_waiting) || !(gpus = free_gpus(*it))) {
+    if (cpu_job ? cpu_running >= cpu_slots_ : (pooled && pooled_waiting) || !(gpus = free_gpus(job, starting))) {
       pooled_waiting = pooled_waiting || pooled;
-      ++it;
+      waiting.push_back(std::move(job));
       continue;
     }
+    starting.push_back({std::move(job), cpu_job ? Held{} : *gpus});
+    cpu_running += cpu_job ? 1 : 0;
+  }
+  queue_ = std::move(waiting);
+  const int threads = std::max(1, cores_ / std::max<int>(1, int(running_.size() + starting.size())));
+  for (Start& s : starting) {
     try {
-      const Held held = cpu_job ? Held{} : *gpus;
       std::string pinned;
-      if (held.pinned)
-        for (const std::string& gpu : held.gpus) pinned += (pinned.empty() ? "" : ",") + gpu;
-      const pid_t pid = launch(*it, pinned);
-      running_[pid] = {std::move(*it), held, Clock::now()};
-      cpu_running += cpu_job ? 1 : 0;
+      if (s.held.pinned)
+        for (const std::string& gpu : s.held.gpus) pinned += (pinned.empty() ? "" : ",") + gpu;
+      const pid_t pid = launch(s.job, pinned, threads);
+      running_[pid] = {std::move(s.job), s.held, Clock::now()};
     } catch (const std::exception& e) {
-      results.push_back({it->id, false, std::string("could not start: ") + e.what(), 0});
+      results.push_back({s.job.id, false, std::string("could not start: ") + e.what(), 0});
     }
-    it = queue_.erase(it);
   }
 }
 

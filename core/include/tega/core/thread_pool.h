@@ -13,9 +13,14 @@
 
 namespace tega {
 
+// What a `threads: 0` option means: the environment's TEGA_THREADS where it is set (tega run
+// gives each job its share of the cores there, and so may a user: TEGA_THREADS=8 tega ...), else
+// one per hardware thread. Throws tega::Error when TEGA_THREADS is not a whole number >= 1.
+int default_thread_count();
+
 class ThreadPool {
  public:
-  explicit ThreadPool(int threads = 0);  // 0: one per hardware thread
+  explicit ThreadPool(int threads = 0);  // 0: default_thread_count()
   ~ThreadPool();
   ThreadPool(const ThreadPool&) = delete;
   ThreadPool& operator=(const ThreadPool&) = delete;

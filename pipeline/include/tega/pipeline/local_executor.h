@@ -11,6 +11,12 @@
 // orchestrator (PR_SET_PDEATHSIG), even when it is killed with SIGKILL, so no
 // orphan keeps writing into a workspace that a new run is cleaning up.
 //
+// The jobs share the machine's cores: each starts with TEGA_THREADS and
+// OMP_NUM_THREADS set to `cores` over the jobs running once it has started
+// (at least 1), which a stage's `threads: 0` takes (default_thread_count()),
+// so that sixteen track jobs on sixteen cores do not run sixteen threads each.
+// Its log's header line says how many.
+//
 // Children are forked from the thread that constructs the executor and calls
 // wait(); the death signal follows that thread, so it must outlive the jobs.
 
@@ -29,9 +35,10 @@ namespace tega::pipeline {
 
 class LocalExecutor : public Executor {
  public:
-  // `gpus`: CUDA_VISIBLE_DEVICES entries (gpus.h), e.g. machine_gpus().
+  // `gpus`: CUDA_VISIBLE_DEVICES entries (gpus.h), e.g. machine_gpus(). `cores`: the threads the
+  // jobs share (0: default_thread_count(), the machine's or the orchestrator's TEGA_THREADS).
   explicit LocalExecutor(int cpu_slots, std::vector<std::string> gpus = {},
-                         std::chrono::milliseconds stop_grace = std::chrono::seconds(5));
+                         std::chrono::milliseconds stop_grace = std::chrono::seconds(5), int cores = 0);
   ~LocalExecutor() override;  // cancel_all()
 
   void submit(Job job) override;
@@ -53,14 +60,21 @@ class LocalExecutor : public Executor {
     std::chrono::steady_clock::time_point started;
   };
 
+  struct Start {
+    Job job;
+    Held held;
+  };
+
   void start_ready_jobs(std::vector<JobResult>& results);
-  // The GPUs `job` can start on now; nullopt while it must wait.
-  std::optional<Held> free_gpus(const Job& job) const;
+  // The GPUs `job` can start on now, beside the running jobs and those `starting`; nullopt while
+  // it must wait.
+  std::optional<Held> free_gpus(const Job& job, const std::vector<Start>& starting) const;
   // Throws tega::Error when the log cannot be opened or fork fails. `pinned`: "a,b" or "".
-  pid_t launch(const Job& job, const std::string& pinned);
+  pid_t launch(const Job& job, const std::string& pinned, int threads);
   bool reap(std::vector<JobResult>& results, bool block);
 
   int cpu_slots_;
+  int cores_;
   std::vector<std::string> gpus_;
   std::chrono::milliseconds stop_grace_;
   std::deque<Job> queue_;
