@@ -285,6 +285,19 @@ void reconstruct_frames(const TakeJob& job, const Options& options, MvsSummary& 
   progress.finish();
 }
 
+// The defaults' matching windows are sized for 512 x 384: at a studio's 3072 x 2048 they span a
+// sixth of the face they are meant to (docs/mvs.md#options), which nothing else would tell.
+void warn_of_small_windows(const Rig& rig, const PatchMatchOptions& patch_match) {
+  int widest = 0;
+  for (const Camera& camera : rig.cameras) widest = std::max(widest, camera.width);
+  if (widest <= 256 * patch_match.window_radius) return;
+  logging::warn("mvs: the cameras are %d pixels wide and patch_match.window_radius is %d: the windows cover under "
+                "half as much of the face as the defaults' at 512 x 384; scale window_radius and window_step with "
+                "the image (12 and 6 at 3072 x 2048, as studio_configs/studio13-capture.yaml sets them; "
+                "docs/mvs.md#options)",
+                widest, patch_match.window_radius);
+}
+
 }  // namespace
 
 MvsSummary reconstruct_capture(const MvsRequest& request, const Options& options) {
@@ -306,6 +319,7 @@ MvsSummary reconstruct_capture(const MvsRequest& request, const Options& options
     }
   }
   const std::string done_key = options_to_yaml(options) + "# rig\n" + read_text_file(rig_file);
+  warn_of_small_windows(rig, options.patch_match);
 
   for (const auto& name : takes) {
     const FrameLoader loader(read_take(capture.root / "takes" / name), rig, rig_file.string());

@@ -7,6 +7,7 @@
 
 #include "tega/core/error.h"
 #include "tega/core/files.h"
+#include "tega/core/log.h"
 #include "tega/core/rig.h"
 #include "tega/mvs/reconstruction.h"
 #include "tega/scoring/studio_truth.h"
@@ -74,6 +75,23 @@ TEST(Mvs, MeshesTheFaceWithinTheTargets) {
   EXPECT_EQ(again.frames_skipped, 1);
   EXPECT_EQ(again.frames_done, 0);
   EXPECT_EQ(fs::last_write_time(out / "meshes" / "expressions" / "000000.ply"), before);
+}
+
+TEST(Mvs, WarnsWhenTheWindowsAreSmallForTheImages) {
+  const tega::test::TempDir dir;
+  MvsRequest request{studio_capture(), {}, dir / "meshes", {}, 5, 6};  // no frame 5: it stops after the check
+  init_logging(1);  // to stderr, as the tega command logs
+  Options sized = cpu_options();
+  sized.patch_match.window_radius = 2;  // 512 wide: as 4 at 1024, fine
+  testing::internal::CaptureStderr();
+  EXPECT_THROW(reconstruct_capture(request, sized), Error);
+  EXPECT_EQ(testing::internal::GetCapturedStderr().find("window_radius"), std::string::npos);
+  Options small = cpu_options();
+  small.patch_match.window_radius = 1;  // as 4 at 2048
+  testing::internal::CaptureStderr();
+  EXPECT_THROW(reconstruct_capture(request, small), Error);
+  const std::string log = testing::internal::GetCapturedStderr();
+  EXPECT_NE(log.find("the cameras are 512 pixels wide and patch_match.window_radius is 1"), std::string::npos) << log;
 }
 
 TEST(Mvs, ACameraMissingFromTheRigIsNamed) {
