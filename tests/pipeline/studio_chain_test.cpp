@@ -205,6 +205,23 @@ TEST(StudioChain, RawCaptureToAvatarWithTheGroundTruthUnreadable) {
   // and alpha) gives an avatar the pipeline's is within 1 dB of, inside the
   // head mask, on every split: what calibration, mvs, track and matting lose.
   make_readable(shard / "capture.truth");
+
+  // tega inspect against the truth: the chain's meshes (the head model's, in the calibrated rig's
+  // world) against the true ones mapped into them put the Gaussians as far off as tracking is,
+  // millimetres; a wrong world would be tens of centimetres, a wrong vertex map centimetres.
+  const fs::path liveness = dir / "liveness.json";
+  const auto inspected = run_tega({"inspect", "--model", (dir / "ws/train/default/run").string(), "--truth",
+                                   (shard / "capture.truth").string(), "--json", liveness.string(), "--device", "cpu"},
+                                  dir.path());
+  ASSERT_EQ(inspected.exit_code, 0) << inspected.output;
+  const json frames = json::parse(read_text_file(liveness)).at(0).at("frames");
+  ASSERT_FALSE(frames.empty()) << read_text_file(liveness);
+  for (const auto& frame : frames) {
+    std::cout << "[ liveness ] " << frame["frame"] << ": the chain's meshes " << frame["mesh_error_mm"] << " mm off\n";
+    EXPECT_GT(frame["mesh_error_mm"].get<double>(), 0.05) << frame.dump();
+    EXPECT_LT(frame["mesh_error_mm"].get<double>(), 8.0) << frame.dump();  // the vertices mapped one for one: 13.7 mm
+  }
+
   write_text(dir / "train.yaml", kTrainOptions + "\n");
   const fs::path truth_run = dir / "truth-run", truth_eval = dir / "truth-eval.json";
   const auto train = run_tega({"train", "--data", (shard / "capture.truth/dataset").string(), "--out",

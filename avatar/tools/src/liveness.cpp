@@ -3,6 +3,7 @@
 #include <ATen/ATen.h>
 #include <ATen/core/grad_mode.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -12,6 +13,7 @@
 #include "tega/core/error.h"
 #include "tega/core/json_file.h"
 #include "tega/core/mesh.h"
+#include "tega/core/rig.h"
 
 #include "image_tensors.h"
 #include "tega/nn/losses.h"
@@ -48,18 +50,45 @@ double expression_mm(const Vertices& world, const RigidTransform& head_to_world,
   return 1000.0 * sum / std::max<int64_t>(1, world.rows());
 }
 
+// The identity where the dataset's cameras stand where the truth's do (tega synth's own dataset),
+// else the camera centres' best fit (a calibrated rig's world).
+RigidTransform truth_to_dataset_world(const Rig& truth, const Rig& dataset) {
+  bool same_world = true;
+  for (const Camera& camera : dataset.cameras) {
+    const auto match = std::find_if(truth.cameras.begin(), truth.cameras.end(),
+                                    [&](const Camera& c) { return c.name == camera.name; });
+    same_world = same_world && match != truth.cameras.end() && (match->center() - camera.center()).norm() < 1e-9;
+  }
+  return same_world ? RigidTransform{} : align_camera_centres(truth, dataset);
+}
+
 // The true coarse mesh and head pose of a dataset frame of a virtual-studio
 // capture: ground_truth/<take>/frames.json and the coarse meshes it names
-// (docs/virtual-studio.md#takes), for dataset frames named <take>_<frame>.
+// (docs/virtual-studio.md#takes), for dataset frames named <take>_<frame>,
+// in the dataset's topology and world. A dataset the raw chain built has
+// neither: its meshes are the head model's, of which the studio's template
+// keeps some vertices (head.json's source_vertex_runs; the model's see-through
+// eye overlays are left out, and keep the dataset's own positions), and its
+// rig is calibrated in a world of its own, which the camera centres tie to the
+// truth's (align_camera_centres).
 class TrueMeshes {
  public:
-  explicit TrueMeshes(const std::filesystem::path& capture) : root_(capture / "ground_truth") {
+  TrueMeshes(const std::filesystem::path& capture, const Dataset& dataset)
+      : root_(capture / "ground_truth"), vertices_(int(dataset.template_mesh.num_vertices())) {
     if (!std::filesystem::is_directory(root_))
       throw Error(capture, "no ground_truth/ folder: --truth takes a tega synth capture (with truth_apart, its "
                            "CAPTURE.truth/)");
+    const std::filesystem::path head = root_ / "head" / "head.json";
+    if (std::filesystem::exists(head)) {
+      const nlohmann::json runs = read_json_file(head).value("source_vertex_runs", nlohmann::json::array());
+      for (const auto& run : runs)
+        for (int v = run.at(0).get<int>(); v <= run.at(1).get<int>(); ++v) model_vertex_.push_back(v);
+    }
+    to_dataset_ = truth_to_dataset_world(read_rig_json(capture / "rig.json"), dataset.rig);
   }
 
-  std::pair<Vertices, RigidTransform> frame(const DatasetFrame& f, int vertices) {
+  // `dataset_vertices`: the frame's mesh in the dataset, which fills what the truth lacks.
+  std::pair<Vertices, RigidTransform> frame(const DatasetFrame& f, const Vertices& dataset_vertices) {
     const std::filesystem::path file = root_ / f.sequence / "frames.json";
     const std::string prefix = f.sequence + "_";
     const std::string number = f.id.substr(std::min(prefix.size(), f.id.size()));
@@ -83,24 +112,43 @@ class TrueMeshes {
       const std::string slot = "{frame:06d}";
       if (coarse.find(slot) == std::string::npos) throw Error(file, "no coarse mesh pattern with " + slot);
       coarse.replace(coarse.find(slot), slot.size(), number);
-      const std::filesystem::path mesh = file.parent_path() / coarse;
-      Vertices true_vertices = read_vertices_bin(mesh);
-      if (true_vertices.rows() != vertices)
-        throw Error(mesh, "has " + std::to_string(true_vertices.rows()) + " vertices, the dataset's meshes " +
-                              std::to_string(vertices) + ": --truth needs a dataset in the studio's own template "
-                              "(tega synth's), not meshes tracked with the head model");
-      return {std::move(true_vertices), RigidTransform::from_matrix(pose)};
+      return {in_dataset(file.parent_path() / coarse, dataset_vertices),
+              to_dataset_ * RigidTransform::from_matrix(pose)};
     }
     throw Error(file, "no frame " + number + " (dataset frame '" + f.id + "')");
   }
 
  private:
+  Vertices in_dataset(const std::filesystem::path& mesh, const Vertices& dataset_vertices) const {
+    const Vertices truth = read_vertices_bin(mesh);
+    const auto moved = [&](int v) {
+      return to_dataset_.apply(truth.row(v).transpose().cast<double>()).cast<float>().transpose().eval();
+    };
+    if (truth.rows() == vertices_) {
+      Vertices out(truth.rows(), 3);
+      for (int v = 0; v < truth.rows(); ++v) out.row(v) = moved(v);
+      return out;
+    }
+    const bool mapped = int(model_vertex_.size()) == truth.rows() && !model_vertex_.empty() &&
+                        *std::max_element(model_vertex_.begin(), model_vertex_.end()) < vertices_;
+    if (!mapped)
+      throw Error(mesh, "has " + std::to_string(truth.rows()) + " vertices, the dataset's meshes " +
+                            std::to_string(vertices_) + ", and head.json's source_vertex_runs do not map one to "
+                            "the other: --truth needs the studio that rendered the dataset's capture");
+    Vertices out = dataset_vertices;
+    for (int v = 0; v < truth.rows(); ++v) out.row(model_vertex_[size_t(v)]) = moved(v);
+    return out;
+  }
+
   const nlohmann::json& take_of(const std::filesystem::path& file) {
     auto found = takes_.find(file);
     return found != takes_.end() ? found->second : takes_[file] = read_json_file(file);
   }
 
   std::filesystem::path root_;
+  int vertices_;
+  std::vector<int> model_vertex_;  // the model's vertex of each of the studio template's
+  RigidTransform to_dataset_;      // the truth's world to the dataset's
   std::map<std::filesystem::path, nlohmann::json> takes_;
 };
 
@@ -253,7 +301,7 @@ Liveness inspect_avatar(trainer::TrainedAvatar& avatar, const Dataset& dataset, 
   std::vector<double> expression, deformation, shading_change;
   FrameSpread deformation_spread, shading_spread;
   std::optional<TrueMeshes> truth;
-  if (!options.truth.empty()) truth.emplace(options.truth);
+  if (!options.truth.empty()) truth.emplace(options.truth, dataset);
   const std::set<std::string> held_out(dataset.test.frames.begin(), dataset.test.frames.end());
   SplitErrors train_errors, test_errors;
   {
@@ -267,7 +315,7 @@ Liveness inspect_avatar(trainer::TrainedAvatar& avatar, const Dataset& dataset, 
       const at::Tensor placed = model.pose(input, without_field).means;
       const at::Tensor deformed = out.deformation ? model.pose(input, avatar.phase).means : placed;
       if (truth) {
-        const auto [true_vertices, true_pose] = truth->frame(f, dataset.template_mesh.num_vertices());
+        const auto [true_vertices, true_pose] = truth->frame(f, vertices);
         const at::Tensor target = model.pose(model.frame_input(true_vertices, true_pose), without_field).means;
         // Row vectors to head space: (world - t) R.
         const auto to_head = [&](const at::Tensor& error) { return error.matmul(input.head_rotation).to(at::kDouble); };

@@ -15,6 +15,7 @@
 
 #include "tega/core/error.h"
 #include "tega/core/mesh.h"
+#include "tega/core/rig.h"
 
 #include "tiny_avatar.h"
 
@@ -25,6 +26,8 @@ namespace {
 // true meshes are the dataset's, shifted by shifts[frame] metres.
 void write_shifted_truth(const std::filesystem::path& capture, const Dataset& d,
                          const std::map<std::string, Eigen::RowVector3f>& shifts) {
+  std::filesystem::create_directories(capture);
+  write_rig_json(d.rig, capture / "rig.json");  // the dataset's cameras where the truth's are
   for (const DatasetFrame& f : d.frames) {
     const std::filesystem::path take = capture / "ground_truth" / f.sequence;
     std::filesystem::create_directories(take / "coarse");
