@@ -1,5 +1,7 @@
 #include "tega/core/thread_pool.h"
 
+#include <sched.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cstdlib>
@@ -10,9 +12,21 @@
 
 namespace tega {
 
+namespace {
+
+// The cores this process may run on: its affinity mask (taskset, a container's cpuset, a Slurm
+// job's binding), which hardware_concurrency() ignores.
+int usable_cores() {
+  cpu_set_t set;
+  if (::sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0) return CPU_COUNT(&set);
+  return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+}
+
+}  // namespace
+
 int default_thread_count() {
   const char* set = std::getenv("TEGA_THREADS");
-  if (set == nullptr || *set == '\0') return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  if (set == nullptr || *set == '\0') return usable_cores();
   const std::string text = set;
   if (text.size() > 6 || text.find_first_not_of("0123456789") != std::string::npos || std::stoi(text) < 1)
     throw Error("TEGA_THREADS must be a whole number of threads, at least 1 (it is '" + text + "')");

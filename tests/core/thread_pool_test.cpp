@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <sched.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -53,7 +54,20 @@ TEST(ThreadPool, ThreadsLeftToTheDefaultAreTegaThreadsWhereItIsSet) {
     }
   }
   ::unsetenv("TEGA_THREADS");
-  EXPECT_EQ(tega::default_thread_count(), int(std::max(1u, std::thread::hardware_concurrency())));
+  // Unset: the cores this process may run on, as taskset or a Slurm job's binding leaves them.
+  cpu_set_t all;
+  ASSERT_EQ(::sched_getaffinity(0, sizeof all, &all), 0);
+  EXPECT_EQ(tega::default_thread_count(), CPU_COUNT(&all));
+  cpu_set_t one;
+  CPU_ZERO(&one);
+  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu)
+    if (CPU_ISSET(cpu, &all)) {
+      CPU_SET(cpu, &one);
+      break;
+    }
+  ASSERT_EQ(::sched_setaffinity(0, sizeof one, &one), 0);
+  EXPECT_EQ(tega::default_thread_count(), 1);
+  ASSERT_EQ(::sched_setaffinity(0, sizeof all, &all), 0);
   if (before) ::setenv("TEGA_THREADS", saved.c_str(), 1);
 }
 

@@ -15,7 +15,8 @@ namespace tega {
 
 // What a `threads: 0` option means: the environment's TEGA_THREADS where it is set (tega run
 // gives each job its share of the cores there, and so may a user: TEGA_THREADS=8 tega ...), else
-// one per hardware thread. Throws tega::Error when TEGA_THREADS is not a whole number >= 1.
+// one per core the process may run on (its affinity: taskset, a cpuset, a Slurm job's cores).
+// Throws tega::Error when TEGA_THREADS is not a whole number >= 1.
 int default_thread_count();
 
 class ThreadPool {
