@@ -6,9 +6,9 @@
 
 #include "dlib_conversions.h"
 #include "mirroring.h"
-#include "tega/core/thread_pool.h"
 #include "tega/core/error.h"
 #include "tega/core/files.h"
+#include "tega/core/thread_pool.h"
 #include "tega/landmarks/landmarks.h"
 
 namespace tega::landmarks {

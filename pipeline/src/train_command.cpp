@@ -5,10 +5,10 @@
 #include "commands.h"
 #include "stage_options.h"
 #include "train_processes.h"
-#include "tega/core/thread_pool.h"
 #include "tega/core/error.h"
 #include "tega/core/log.h"
 #include "tega/core/options.h"
+#include "tega/core/thread_pool.h"
 #include "tega/pipeline/gpus.h"
 #include "tega/trainer/trainer.h"
 

@@ -17,12 +17,12 @@
 #include <sstream>
 
 #include "tega/core/error.h"
-#include "tega/core/thread_pool.h"
 #include "tega/core/files.h"
 #include "tega/core/interrupt.h"
 #include "tega/core/log.h"
 #include "tega/core/options.h"
 #include "tega/core/progress.h"
+#include "tega/core/thread_pool.h"
 #include "tega/nn/losses.h"
 #include "tega/nn/module_io.h"
 #include "tega/nn/vgg_loss.h"

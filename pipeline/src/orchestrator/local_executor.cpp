@@ -46,9 +46,10 @@ std::vector<std::string> child_environment(const std::string& gpu, int threads) 
                                     kOpenMp = "OMP_NUM_THREADS=";
   const auto is = [](std::string_view entry, std::string_view name) { return entry.substr(0, name.size()) == name; };
   std::vector<std::string> environment;
-  for (char** entry = environ; *entry != nullptr; ++entry)
-    if (!(is(*entry, kVisible) && !gpu.empty()) && !is(*entry, kThreads) && !is(*entry, kOpenMp))
-      environment.push_back(*entry);
+  for (char** entry = environ; *entry != nullptr; ++entry) {
+    const bool replaced = (!gpu.empty() && is(*entry, kVisible)) || is(*entry, kThreads) || is(*entry, kOpenMp);
+    if (!replaced) environment.push_back(*entry);
+  }
   if (!gpu.empty()) environment.push_back(std::string(kVisible) + gpu);
   environment.push_back(std::string(kThreads) + std::to_string(threads));
   environment.push_back(std::string(kOpenMp) + std::to_string(threads));
@@ -121,18 +122,18 @@ pid_t LocalExecutor::launch(const Job& job, const std::string& pinned, int threa
   return pid;
 }
 
-std::optional<LocalExecutor::Held> LocalExecutor::free_gpus(const Job& job, const std::vector<Start>& starting) const {
+std::optional<LocalExecutor::Held> LocalExecutor::free_gpus(const Job& job, const std::vector<Running>& starting) const {
   // The jobs on `gpu` now (running or starting in this pass), or nullopt when `job` may not join
   // them: a GPU runs at most as many jobs as the strictest of their jobs_per_gpu and the job's own allow.
   const auto jobs_beside = [&](const std::string& gpu) -> std::optional<int> {
     int jobs = 0, bound = jobs_sharing_a_gpu(job.resources);
-    const auto count = [&](const Held& held, const Resources& resources) {
-      if (std::find(held.gpus.begin(), held.gpus.end(), gpu) == held.gpus.end()) return;
+    const auto count = [&](const Running& r) {
+      if (std::find(r.held.gpus.begin(), r.held.gpus.end(), gpu) == r.held.gpus.end()) return;
       ++jobs;
-      bound = std::min(bound, jobs_sharing_a_gpu(resources));
+      bound = std::min(bound, jobs_sharing_a_gpu(r.job.resources));
     };
-    for (const auto& [pid, r] : running_) count(r.held, r.job.resources);
-    for (const Start& s : starting) count(s.held, s.job.resources);
+    for (const auto& [pid, r] : running_) count(r);
+    for (const Running& r : starting) count(r);
     if (jobs >= bound) return std::nullopt;
     return jobs;
   };
@@ -158,7 +159,7 @@ void LocalExecutor::start_ready_jobs(std::vector<JobResult>& results) {
   int cpu_running = 0;
   for (const auto& [pid, r] : running_) cpu_running += r.held.gpus.empty() ? 1 : 0;
   // First which jobs start, then their share of the cores among all that will be running.
-  std::vector<Start> starting;
+  std::vector<Running> starting;
   std::deque<Job> waiting;
   // Jobs for any of the run's GPUs start in queue order: a job waiting for several GPUs is not
   // starved by later ones that each take one as it frees.
@@ -179,18 +180,19 @@ void LocalExecutor::start_ready_jobs(std::vector<JobResult>& results) {
       waiting.push_back(std::move(job));
       continue;
     }
-    starting.push_back({std::move(job), cpu_job ? Held{} : *gpus});
+    starting.push_back({std::move(job), cpu_job ? Held{} : *gpus, {}});
     cpu_running += cpu_job ? 1 : 0;
   }
   queue_ = std::move(waiting);
   const int threads = std::max(1, cores_ / std::max<int>(1, int(running_.size() + starting.size())));
-  for (Start& s : starting) {
+  for (Running& s : starting) {
     try {
       std::string pinned;
       if (s.held.pinned)
         for (const std::string& gpu : s.held.gpus) pinned += (pinned.empty() ? "" : ",") + gpu;
       const pid_t pid = launch(s.job, pinned, threads);
-      running_[pid] = {std::move(s.job), s.held, Clock::now()};
+      s.started = Clock::now();
+      running_[pid] = std::move(s);
     } catch (const std::exception& e) {
       results.push_back({s.job.id, false, std::string("could not start: ") + e.what(), 0});
     }

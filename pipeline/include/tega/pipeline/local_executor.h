@@ -60,15 +60,10 @@ class LocalExecutor : public Executor {
     std::chrono::steady_clock::time_point started;
   };
 
-  struct Start {
-    Job job;
-    Held held;
-  };
-
   void start_ready_jobs(std::vector<JobResult>& results);
-  // The GPUs `job` can start on now, beside the running jobs and those `starting`; nullopt while
-  // it must wait.
-  std::optional<Held> free_gpus(const Job& job, const std::vector<Start>& starting) const;
+  // The GPUs `job` can start on now, beside the running jobs and those `starting` (not yet
+  // launched); nullopt while it must wait.
+  std::optional<Held> free_gpus(const Job& job, const std::vector<Running>& starting) const;
   // Throws tega::Error when the log cannot be opened or fork fails. `pinned`: "a,b" or "".
   pid_t launch(const Job& job, const std::string& pinned, int threads);
   bool reap(std::vector<JobResult>& results, bool block);
