@@ -7,7 +7,7 @@
 #include <limits>
 #include <optional>
 
-#include "image_tensors.h"
+#include "async_images.h"
 #include "tega/core/error.h"
 #include "tega/core/files.h"
 #include "tega/core/progress.h"
@@ -64,9 +64,11 @@ std::vector<SplitResult> evaluate_avatar(trainer::TrainedAvatar& avatar, const D
   std::optional<Lpips> lpips_here;
   if (lpips) lpips_here = lpips->to(device);
 
-  int64_t total = 0;
-  for (const auto& s : splits) total += static_cast<int64_t>(s.views.size());
-  Progress progress("eval", total, "views");
+  std::vector<fs::path> files;
+  for (const auto& s : splits)
+    for (const EvalView& view : s.views) files.push_back(dataset.image_path(view.camera, view.frame));
+  detail::ImagePrefetcher images(files);
+  Progress progress("eval", static_cast<int64_t>(files.size()), "views");
   at::NoGradGuard no_grad;
   std::vector<SplitResult> results;
   for (const SplitViews& s : splits) {
@@ -87,7 +89,7 @@ std::vector<SplitResult> evaluate_avatar(trainer::TrainedAvatar& avatar, const D
       }
       const Camera& camera = dataset.rig.camera(view.camera);
       const fs::path file = dataset.image_path(view.camera, view.frame);
-      const at::Tensor rgba = detail::read_rgba(file).to(device);
+      const at::Tensor rgba = images.next().to(device);
       if (rgba.size(0) != camera.height || rgba.size(1) != camera.width)
         throw Error(file, "is " + std::to_string(rgba.size(1)) + "x" + std::to_string(rgba.size(0)) + ", camera " +
                               view.camera + " is " + std::to_string(camera.width) + "x" + std::to_string(camera.height));

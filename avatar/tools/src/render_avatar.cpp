@@ -6,6 +6,7 @@
 #include <set>
 #include <nlohmann/json.hpp>
 
+#include "async_images.h"
 #include "image_tensors.h"
 #include "tega/core/error.h"
 #include "tega/core/files.h"
@@ -175,6 +176,7 @@ RenderSummary render_avatar(trainer::TrainedAvatar& avatar, const Dataset& datas
   const at::Tensor background = at::tensor(avatar.options.background, at::kFloat).to(device);
   RenderSummary summary;
   Progress progress("render", static_cast<int64_t>(job.frames.size() * job.cameras.size()), "images");
+  detail::BackgroundImageWriter writer;  // after `staged`: its files are all written before that is dropped
   at::NoGradGuard no_grad;
   for (const RenderFrame& frame : job.frames) {
     const trainer::FrameInput input = avatar.model.frame_input(frame.world_vertices, frame.head_to_world);
@@ -183,7 +185,7 @@ RenderSummary render_avatar(trainer::TrainedAvatar& avatar, const Dataset& datas
       const at::Tensor rgb =
           trainer::render_view(avatar.model, input, camera, avatar.phase, background, avatar.options.antialiased);
       fs::create_directories(staged.path() / camera.name);
-      write_image(detail::to_image(rgb), staged.path() / camera.name / (frame.id + ext));
+      writer.write(rgb, staged.path() / camera.name / (frame.id + ext));
       ++summary.images;
 
       const fs::path truth = dataset.image_path(camera.name, frame.id);
@@ -195,13 +197,13 @@ RenderSummary render_avatar(trainer::TrainedAvatar& avatar, const Dataset& datas
           target = at::upsample_bilinear2d(target.unsqueeze(0), size, /*align_corners=*/false).squeeze(0);
         }
         fs::create_directories(staged.path() / "side_by_side" / camera.name);
-        write_image(detail::to_image(at::cat({rgb, target}, 2)),
-                    staged.path() / "side_by_side" / camera.name / (frame.id + ".png"));
+        writer.write(at::cat({rgb, target}, 2), staged.path() / "side_by_side" / camera.name / (frame.id + ".png"));
         ++summary.side_by_side;
       }
       progress.advance();
     }
   }
+  writer.finish();
   progress.finish();
 
   if (!job.video) {
