@@ -10,7 +10,6 @@
 #include "report_context.h"
 #include "tega/core/error.h"
 #include "tega/core/files.h"
-#include "tega/core/log.h"
 
 #include "tega/scoring/matte_scores.h"
 
@@ -57,7 +56,6 @@ double coverage(const std::vector<fs::path>& mattes) {
 // 0.02 per image, 0.1 within 3 px of the edge, silhouette IoU 0.98.
 void score_take(const std::string& stage_name, const fs::path& mattes, const std::string& take, Section& section,
                 ReportContext& context) {
-  logging::info("report: scoring the mattes of take %s against the studio's alpha", take.c_str());
   const scoring::MatteScores s = scoring::score_mattes(mattes, context.subject.truth, take);
   Table table{{"measure", "mean", "worst image", "target"}, {}};
   const std::string stage = stage_name + " (" + take + ")";

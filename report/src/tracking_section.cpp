@@ -12,7 +12,6 @@
 #include "report_context.h"
 #include "tega/core/error.h"
 #include "tega/core/files.h"
-#include "tega/core/log.h"
 
 #include "tega/scoring/tracking_scores.h"
 
@@ -80,7 +79,6 @@ std::string or_dash(double value, int decimals) { return std::isfinite(value) ? 
 // median 1 mm and p95 3 mm, rotation 0.5 deg, blink and jaw correlation 0.9.
 void score_take(const std::string& stage, const fs::path& tracked, const std::string& take, Section& section,
                 ReportContext& context) {
-  logging::info("report: scoring tracked take %s against the studio's truth", take.c_str());
   const scoring::TrackScores s = scoring::score_against_studio(tracked, context.subject.truth, take,
                                                                     calibrated_to_truth_world(context.subject));
   Table table{{"measure", "value", "target"}, {}};

@@ -10,6 +10,7 @@
 #include "tega/core/files.h"
 #include "tega/core/json_file.h"
 #include "tega/core/rig.h"
+#include "tega/core/thread_pool.h"
 #include "tega/synth/ground_truth_depth.h"
 
 namespace tega::scoring {
@@ -40,11 +41,16 @@ std::vector<bool> coarse_face_region(const Mesh& coarse, const nlohmann::json& h
 // How many of the rig's cameras see each listed face's centroid: in the
 // image, facing the camera, and no more than kDepthTolerance behind the
 // nearest surface there. Depth is rendered at most kMaxSide pixels wide:
-// enough to tell a face from the lips or eyelids that hide it.
+// enough to tell a face from the lips or eyelids that hide it. The cameras
+// render on threads of their own: a 3072 x 2048 studio's fine head took 2 s
+// a frame with them one after the other.
 std::vector<int> cameras_seeing(const Mesh& mesh, const std::vector<int>& faces, const Rig& rig) {
   constexpr double kDepthTolerance = 0.002, kMaxSide = 1024;
-  std::vector<int> seen(faces.size(), 0);
-  for (const Camera& full : rig.cameras) {
+  std::vector<std::vector<char>> seen_by(rig.cameras.size(), std::vector<char>(faces.size(), 0));
+  ThreadPool pool(std::min<int>(default_thread_count(), int(rig.cameras.size())));
+  pool.parallel_for(0, int64_t(rig.cameras.size()), [&](int64_t k) {
+    const Camera& full = rig.cameras[size_t(k)];
+    std::vector<char>& seen = seen_by[size_t(k)];
     Camera camera = full.scaled(std::min(1.0, kMaxSide / std::max(full.width, full.height)));
     camera.distortion = {};
     const ImageF depth = synth::render_depth(camera, mesh.positions, mesh.faces);
@@ -62,9 +68,12 @@ std::vector<int> cameras_seeing(const Mesh& mesh, const std::vector<int>& faces,
       if (x < 0 || y < 0 || x >= camera.width || y >= camera.height) continue;
       const float nearest = depth.at(x, y, 0);
       const double z = camera.world_to_camera.apply(point).z();
-      if (nearest > 0 && z <= nearest + kDepthTolerance) ++seen[i];
+      if (nearest > 0 && z <= nearest + kDepthTolerance) seen[i] = 1;
     }
-  }
+  });
+  std::vector<int> seen(faces.size(), 0);
+  for (const std::vector<char>& by_camera : seen_by)
+    for (size_t i = 0; i < faces.size(); ++i) seen[i] += by_camera[i];
   return seen;
 }
 

@@ -9,6 +9,7 @@
 #include "tega/core/error.h"
 #include "tega/core/json_file.h"
 #include "tega/core/mesh.h"
+#include "tega/core/progress.h"
 #include "tega/core/tracked.h"
 #include "tega/scoring/studio_truth.h"
 
@@ -92,6 +93,8 @@ TrackScores TakeTruth::score(const std::vector<ScoredFrame>& tracked, const Vert
   }
   std::vector<double> errors, rotations, pose_rotations;
   std::map<std::string, std::pair<std::vector<double>, std::vector<double>>> series;  // truth, tracked
+  // A frame's face region renders its fine head from every camera: seconds a frame at the studio's size.
+  Progress progress("scoring tracked take " + take_ + " against the studio's truth", int64_t(tracked.size()), "frames");
   for (const ScoredFrame& t : tracked) {
     if (!rotation_.count(t.frame)) throw Error(frames_file_, "has no frame " + std::to_string(t.frame));
     const Vertices& true_mesh = coarse_.at(t.frame);
@@ -109,7 +112,9 @@ TrackScores TakeTruth::score(const std::vector<ScoredFrame>& tracked, const Vert
       tracked_values.push_back(t.expression.count(expression) ? t.expression.at(expression) : 0.0);
     }
     ++scores.frames;
+    progress.advance();
   }
+  progress.finish();
   if (scores.frames == 0) throw Error("no tracked frame to score");
   scores.vertex_median_m = percentile(errors, 0.5);
   scores.vertex_p95_m = percentile(errors, 0.95);
