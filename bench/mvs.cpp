@@ -280,7 +280,7 @@ int main(int argc, char** argv) {
     std::vector<int> map_views(prepared.views.size());
     std::iota(map_views.begin(), map_views.end(), 0);
     auto start = Clock::now();
-    prepared.cloud = mvs::fuse_depth_maps(prepared.views, map_views, prepared.maps, fusion_options, &pool);
+    prepared.cloud = mvs::fuse_depth_maps(prepared.views, map_views, prepared.maps, fusion_options, &pool, depth_device);
     prepared.times.fusion_s = seconds_since(start);
 #ifdef TEGA_BENCH_HAVE_SURFACE
     start = Clock::now();

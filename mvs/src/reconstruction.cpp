@@ -113,10 +113,10 @@ FrameReconstruction estimate_depth(const std::vector<StereoView>& views, const O
 }
 
 // The second half: fusion and the surface.
-void fuse_and_mesh(const std::vector<StereoView>& views, const Options& options, const std::string& label,
+void fuse_and_mesh(const std::vector<StereoView>& views, const Options& options, Device device, const std::string& label,
                    ThreadPool& pool, FrameReconstruction& result) {
   auto start = Clock::now();
-  result.cloud = fuse_depth_maps(views, result.map_views, result.depth_maps, options.fusion, &pool);
+  result.cloud = fuse_depth_maps(views, result.map_views, result.depth_maps, options.fusion, &pool, device);
   result.timings.fusion_s = seconds_since(start);
   if (result.cloud.size() < 100)
     throw Error(label + ": only " + std::to_string(result.cloud.size()) +
@@ -134,7 +134,7 @@ void fuse_and_mesh(const std::vector<StereoView>& views, const Options& options,
 FrameReconstruction reconstruct_views(const std::vector<StereoView>& views, const Options& options, Device device,
                                       const std::string& label, ThreadPool& pool) {
   FrameReconstruction result = estimate_depth(views, options, device, label, pool);
-  fuse_and_mesh(views, options, label, pool, result);
+  fuse_and_mesh(views, options, device, label, pool, result);
   return result;
 }
 
@@ -266,7 +266,7 @@ void reconstruct_frames(const TakeJob& job, const Options& options, MvsSummary& 
     const std::vector<StereoView>& views = prepared.views;
     FrameReconstruction& r = prepared.reconstruction;
     naming_the_frame(label, [&] {
-      fuse_and_mesh(views, options, label, pool, r);
+      fuse_and_mesh(views, options, summary.device, label, pool, r);
       const auto start = Clock::now();
       if (options.write_workspace) write_frame_workspace(views, r, job.out / "colmap" / frame_name(frame));
       write_mesh(r.mesh, job.out / (frame_name(frame) + ".ply"));
@@ -395,7 +395,8 @@ FrameTimings mesh_workspace(const fs::path& workspace, const fs::path& out, cons
 
   ThreadPool pool(options.threads);
   start = Clock::now();
-  const OrientedPointCloud cloud = fuse_depth_maps(views, map_views, maps, options.fusion, &pool);
+  const OrientedPointCloud cloud =
+      fuse_depth_maps(views, map_views, maps, options.fusion, &pool, resolve_device(options.device));
   timings.fusion_s = seconds_since(start);
   if (cloud.size() < 100)
     throw Error(workspace, "only " + std::to_string(cloud.size()) + " points survived fusion of its depth maps");

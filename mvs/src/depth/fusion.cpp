@@ -6,6 +6,7 @@
 #include <optional>
 #include <unordered_map>
 
+#include "fusion_cuda.h"
 #include "tega/core/error.h"
 #include "tega/core/log.h"
 #include "tega/core/thread_pool.h"
@@ -20,76 +21,38 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 // A view's pinhole camera in float: fusion projects every pixel into every
 // other view, and Camera::project's double precision and lens model cost
 // several times more than the arithmetic needs (the views are undistorted).
-struct MapView {
-  const DepthMap* map;
-  const StereoView* view;
-  Eigen::Matrix3f R, R_world;  // world -> camera, camera -> world
-  Eigen::Vector3f t, centre;   // world -> camera translation; the camera centre in the world
-  Eigen::Matrix3f K, K_inverse;
-
-  Eigen::Vector3f to_camera(const Eigen::Vector3f& world) const { return R * world + t; }
-  // The pixel of a point in front of the camera (in camera coordinates).
-  Eigen::Vector2f pixel(const Eigen::Vector3f& camera) const {
-    const Eigen::Vector3f p = K * camera;
-    return {p.x() / p.z(), p.y() / p.z()};
+detail::FusionView fusion_view(const StereoView& view, const DepthMap& map) {
+  detail::FusionView v;
+  v.depth = map.depth.data();
+  v.normals = map.normals.data();
+  v.colour = view.colour.empty() ? nullptr : view.colour.pixels.data();
+  v.grey = view.grey.pixels.data();
+  v.width = map.width;
+  v.height = map.height;
+  const Eigen::Matrix3f R = view.camera.world_to_camera.R.cast<float>();
+  const Eigen::Matrix3f K = view.camera.K.cast<float>(), K_inverse = view.camera.K.inverse().cast<float>();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      v.R[3 * i + j] = R(i, j);
+      v.R_world[3 * i + j] = R(j, i);
+      v.K[3 * i + j] = K(i, j);
+      v.K_inverse[3 * i + j] = K_inverse(i, j);
+    }
+  const Eigen::Vector3f t = view.camera.world_to_camera.t.cast<float>(), centre = view.camera.center().cast<float>();
+  for (int k = 0; k < 3; ++k) {
+    v.t[k] = t(k);
+    v.centre[k] = centre(k);
   }
-};
+  return v;
+}
 
 struct FusedPoint {
   Eigen::Vector3f point, normal, colour;
 };
 
-Eigen::Vector3f colour_at(const StereoView& view, int x, int y) {
-  if (!view.colour.empty())
-    return {float(view.colour.at(x, y, 0)), float(view.colour.at(x, y, 1)), float(view.colour.at(x, y, 2))};
-  const float g = 255.0f * view.grey.at(x, y, 0);
-  return {g, g, g};
-}
-
-Eigen::Vector3f world_point(const MapView& m, int x, int y, float depth) {
-  return m.R_world * (depth * (m.K_inverse * Eigen::Vector3f(float(x), float(y), 1.0f))) + m.centre;
-}
-
-Eigen::Vector3f world_normal(const MapView& m, size_t i) {
-  return m.R_world * Eigen::Vector3f(m.map->normals[3 * i], m.map->normals[3 * i + 1], m.map->normals[3 * i + 2]);
-}
-
-std::optional<FusedPoint> fuse_pixel(const std::vector<MapView>& maps, size_t r, int x, int y,
-                                     const FusionOptions& o, float cos_max_angle) {
-  const MapView& ref = maps[r];
-  const size_t i = ref.map->index(x, y);
-  const float depth = ref.map->depth[i];
-  if (depth <= 0) return std::nullopt;
-  const Eigen::Vector3f X = world_point(ref, x, y, depth);
-  const Eigen::Vector3f n = world_normal(ref, i);
-  FusedPoint sum{X, n, colour_at(*ref.view, x, y)};
-  int confirmations = 0;
-  for (size_t v = 0; v < maps.size(); ++v) {
-    if (v == r) continue;
-    const MapView& other = maps[v];
-    const Eigen::Vector3f in_other = other.to_camera(X);
-    if (in_other.z() <= 0) continue;
-    const Eigen::Vector2f pixel = other.pixel(in_other);
-    const int ox = int(std::lround(pixel.x())), oy = int(std::lround(pixel.y()));
-    if (ox < 0 || oy < 0 || ox >= other.map->width || oy >= other.map->height) continue;
-    const size_t j = other.map->index(ox, oy);
-    const float other_depth = other.map->depth[j];
-    if (other_depth <= 0) continue;
-    if (std::abs(in_other.z() - other_depth) > o.max_depth_error * other_depth) continue;
-    const Eigen::Vector3f Y = world_point(other, ox, oy, other_depth);
-    const Eigen::Vector3f back = ref.to_camera(Y);
-    if (back.z() <= 0 || (ref.pixel(back) - Eigen::Vector2f(float(x), float(y))).norm() > o.max_reprojection_px)
-      continue;
-    const Eigen::Vector3f m = world_normal(other, j);
-    if (m.dot(n) < cos_max_angle) continue;
-    sum.point += Y;
-    sum.normal += m;
-    sum.colour += colour_at(*other.view, ox, oy);
-    ++confirmations;
-  }
-  if (confirmations < o.min_consistent_views) return std::nullopt;
-  const float count = float(confirmations + 1);
-  return FusedPoint{sum.point / count, sum.normal.normalized(), sum.colour / count};
+FusedPoint fused_point(const detail::FusedSample& s) {
+  return {Eigen::Vector3f(s.point[0], s.point[1], s.point[2]), Eigen::Vector3f(s.normal[0], s.normal[1], s.normal[2]),
+          Eigen::Vector3f(s.colour[0], s.colour[1], s.colour[2])};
 }
 
 struct VoxelSum {
@@ -160,43 +123,48 @@ std::vector<FusedPoint> merge_voxels(const std::vector<FusedPoint>& points, doub
 }  // namespace
 
 OrientedPointCloud fuse_depth_maps(const std::vector<StereoView>& views, const std::vector<int>& map_views,
-                                   const std::vector<DepthMap>& maps, const FusionOptions& options, ThreadPool* pool) {
+                                   const std::vector<DepthMap>& maps, const FusionOptions& options, ThreadPool* pool,
+                                   Device device) {
   if (map_views.size() != maps.size()) throw Error("fusion: one view index per depth map is needed");
   if (options.pixel_step < 1) throw Error("fusion: pixel_step must be at least 1");
-  std::vector<MapView> inputs;
+  std::vector<detail::FusionView> inputs;
   for (size_t k = 0; k < maps.size(); ++k) {
     const StereoView& view = views.at(map_views[k]);
     if (maps[k].width != view.camera.width || maps[k].height != view.camera.height)
       throw Error("fusion: the depth map of " + view.camera.name + " does not have the camera's size");
     if (view.camera.has_distortion()) throw Error("fusion: the camera of " + view.camera.name + " must be undistorted");
-    MapView m;
-    m.map = &maps[k];
-    m.view = &view;
-    m.R = view.camera.world_to_camera.R.cast<float>();
-    m.R_world = m.R.transpose();
-    m.t = view.camera.world_to_camera.t.cast<float>();
-    m.centre = view.camera.center().cast<float>();
-    m.K = view.camera.K.cast<float>();
-    m.K_inverse = view.camera.K.inverse().cast<float>();
-    inputs.push_back(m);
+    if (view.colour.empty() && view.grey.pixels.size() != size_t(view.camera.width) * view.camera.height)
+      throw Error("fusion: the view of " + view.camera.name + " has neither a colour nor a grey image of its size");
+    inputs.push_back(fusion_view(view, maps[k]));
   }
   std::optional<ThreadPool> own_pool;
   if (!pool) pool = &own_pool.emplace(0);
-  const float cos_max_angle = std::cos(options.max_normal_angle_deg * float(M_PI) / 180.0f);
+  detail::FusionParameters parameters;
+  parameters.min_consistent_views = options.min_consistent_views;
+  parameters.max_depth_error = options.max_depth_error;
+  parameters.max_reprojection_px = options.max_reprojection_px;
+  parameters.cos_max_angle = std::cos(options.max_normal_angle_deg * float(M_PI) / 180.0f);
 
   const auto start = std::chrono::steady_clock::now();
-  // Rows in parallel, collected in row order: the same cloud for any thread count.
-  std::vector<std::vector<FusedPoint>> rows;
   std::vector<FusedPoint> points;
-  for (size_t r = 0; r < inputs.size(); ++r) {
-    const int width = inputs[r].map->width, height = inputs[r].map->height, step = options.pixel_step;
-    rows.assign(size_t((height + step - 1) / step), {});
-    pool->parallel_for(0, int64_t(rows.size()), [&](int64_t row) {
-      const int y = int(row) * step;
-      for (int x = 0; x < width; x += step)
-        if (auto p = fuse_pixel(inputs, r, x, y, options, cos_max_angle)) rows[size_t(row)].push_back(*p);
-    });
-    for (const auto& row : rows) points.insert(points.end(), row.begin(), row.end());
+  if (device == Device::cuda) {
+    for (const detail::FusedSample& s : detail::fuse_pixels_cuda(inputs, parameters, options.pixel_step))
+      points.push_back(fused_point(s));
+  } else {
+    // Rows in parallel, collected in row order: the same cloud for any thread count.
+    std::vector<std::vector<FusedPoint>> rows;
+    for (size_t r = 0; r < inputs.size(); ++r) {
+      const int width = inputs[r].width, height = inputs[r].height, step = options.pixel_step;
+      rows.assign(size_t((height + step - 1) / step), {});
+      pool->parallel_for(0, int64_t(rows.size()), [&](int64_t row) {
+        const int y = int(row) * step;
+        detail::FusedSample sample;
+        for (int x = 0; x < width; x += step)
+          if (detail::fuse_pixel(inputs.data(), int(inputs.size()), int(r), x, y, parameters, sample))
+            rows[size_t(row)].push_back(fused_point(sample));
+      });
+      for (const auto& row : rows) points.insert(points.end(), row.begin(), row.end());
+    }
   }
   const double pixels_s = seconds_since(start);
   OrientedPointCloud cloud =

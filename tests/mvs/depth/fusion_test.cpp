@@ -2,6 +2,8 @@
 // that no other view confirms dropped.
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include "tega/core/error.h"
 #include "tega/mvs/fusion.h"
 
@@ -116,6 +118,57 @@ TEST(Fusion, PixelStepTakesEveryNthPixel) {
   for (int i = 0; i < sparse.size(); ++i) ASSERT_NEAR(sparse.points.row(i).cast<double>().norm(), kRadius, 2e-4);
   o.pixel_step = 0;
   EXPECT_THROW(fuse_depth_maps(s.views, s.map_views, s.maps, o), Error);
+}
+
+// The sphere's maps with noise, so that fusion's thresholds decide, and colours on every other view.
+Scene noisy_coloured_sphere() {
+  Scene s = sphere_scene();
+  std::mt19937 rng(3);
+  std::normal_distribution<float> noise(0.0f, 0.0003f);
+  for (DepthMap& map : s.maps)
+    for (float& depth : map.depth)
+      if (depth > 0) depth += noise(rng);
+  for (size_t k = 0; k < s.views.size(); k += 2) {
+    StereoView& view = s.views[k];
+    view.colour = Image8(view.camera.width, view.camera.height, 3);
+    for (int y = 0; y < view.camera.height; ++y)
+      for (int x = 0; x < view.camera.width; ++x) {
+        view.colour.at(x, y, 0) = uint8_t(2 * x);
+        view.colour.at(x, y, 1) = uint8_t(3 * y);
+        view.colour.at(x, y, 2) = uint8_t(40 * k);
+      }
+  }
+  return s;
+}
+
+template <class Rows>
+Eigen::Vector3d mean_row(const Rows& rows) {
+  return rows.template cast<double>().colwise().mean().transpose();
+}
+
+TEST(FusionCuda, MatchesTheCpuPath) {
+  if (!cuda_device_available()) GTEST_SKIP() << "no CUDA device";
+  const Scene s = noisy_coloured_sphere();
+  for (const double voxel : {0.0, 0.004})
+    for (const int step : {1, 2}) {
+      SCOPED_TRACE("voxel " + std::to_string(voxel) + " m, pixel step " + std::to_string(step));
+      FusionOptions o;
+      o.voxel_size_m = voxel;
+      o.pixel_step = step;
+      const OrientedPointCloud cpu = fuse_depth_maps(s.views, s.map_views, s.maps, o, nullptr, Device::cpu);
+      const OrientedPointCloud gpu = fuse_depth_maps(s.views, s.map_views, s.maps, o, nullptr, Device::cuda);
+      ASSERT_GT(cpu.size(), 500);
+      // The kernel's fast-math division and square root may tip a pixel on a threshold.
+      ASSERT_NEAR(gpu.size(), cpu.size(), 0.005 * cpu.size());
+      EXPECT_LT((mean_row(gpu.points) - mean_row(cpu.points)).norm(), 2e-5);
+      EXPECT_LT((mean_row(gpu.normals) - mean_row(cpu.normals)).norm(), 2e-3);
+      EXPECT_LT((mean_row(gpu.colors) - mean_row(cpu.colors)).norm(), 1.0);
+      if (gpu.size() != cpu.size()) continue;
+      // The same points in the same order.
+      EXPECT_LT((gpu.points - cpu.points).cwiseAbs().maxCoeff(), 1e-5);
+      EXPECT_LT((gpu.normals - cpu.normals).cwiseAbs().maxCoeff(), 1e-4);
+      EXPECT_LE((gpu.colors.cast<int>() - cpu.colors.cast<int>()).cwiseAbs().maxCoeff(), 1);
+    }
 }
 
 }  // namespace

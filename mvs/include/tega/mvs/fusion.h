@@ -38,8 +38,11 @@ struct FusionOptions {
 
 // `maps[k]` is the estimate of view `map_views[k]`. Colours come from each
 // view's `colour` image where present (RGB, 8-bit), else from its grey image.
+// The pixels are fused on `device` (the CPU's `pool`, nullptr: a pool of its
+// own; or the GPU, the same points in the same order), the voxels merged on
+// the CPU. Device::cuda throws tega::Error without CUDA or a usable GPU.
 OrientedPointCloud fuse_depth_maps(const std::vector<StereoView>& views, const std::vector<int>& map_views,
                                    const std::vector<DepthMap>& maps, const FusionOptions& options,
-                                   ThreadPool* pool = nullptr);
+                                   ThreadPool* pool = nullptr, Device device = Device::cpu);
 
 }  // namespace tega::mvs

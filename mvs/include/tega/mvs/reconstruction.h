@@ -44,7 +44,7 @@ struct Options {
     v("subject_radius_m", subject_radius_m, "Depths searched: the point the rig aims at, plus or minus this (metres).");
     v("depth_range_m", depth_range_m, "[min, max] depth in metres along each camera's axis; overrides subject_radius_m.");
     v("min_views", min_views, "A frame needs the subject seen by at least this many cameras.");
-    v("device", device, "Where depth estimation runs: cpu, cuda, or auto (cuda when a GPU is available).");
+    v("device", device, "Where depth estimation and fusion run: cpu, cuda, or auto (cuda when a GPU is available).");
     v("threads", threads, "CPU worker threads (0: one per hardware thread).");
     v("write_workspace", write_workspace, "Also write each frame's COLMAP dense workspace under colmap/<frame>/.");
   }
