@@ -2,7 +2,7 @@
 // each stage timed (load, depth, fusion, surface) and scored against the
 // studio's ground truth: depth maps against rendered true depth, and (where
 // tega_mvs_surface is built, Open3D) the mesh's accuracy and completeness over
-// the face. With --take-frames N, then frames 0 to N - 1 overlapped as
+// the face. With --take-frames N, then frames 0 to N - 1 pipelined as
 // `tega mvs` runs a take (frame_pipeline.h): the seconds per frame of a take.
 // The capture is rendered once into --capture and kept for the next run.
 #include <CLI/CLI.hpp>
@@ -158,7 +158,7 @@ int main(int argc, char** argv) {
   app.add_option("--height", height, "Image height.");
   app.add_option("--frame", frame, "Frame of the take.");
   app.add_option("--take-frames", take_frames,
-                 "Then mesh frames 0 to N - 1 of the take overlapped, as tega mvs does, and print the seconds per frame.");
+                 "Then mesh frames 0 to N - 1 of the take pipelined, as tega mvs does, and print the seconds per frame.");
   app.add_option("--device", device, "cpu or cuda.");
   app.add_option("--threads", threads, "CPU threads (0 = all).");
   app.add_option("--capture", capture, "Where the rendered capture is kept between runs (suffixed with its size).");
@@ -254,11 +254,12 @@ int main(int argc, char** argv) {
 #endif
   // A frame's first half (views, masks, depth maps), then its second (fusion
   // and surface): run one after the other for the split of one frame, and
-  // overlapped across the frames of the take as `tega mvs` runs them.
+  // pipelined across the frames of the take as `tega mvs` runs them (the load,
+  // the depth maps, the rest).
   const mvs::Device depth_device = mvs::parse_device(device);
-  const auto prepare = [&](int f) {
+  const auto load = [&](int f) {
     PreparedFrame prepared;
-    auto start = Clock::now();
+    const auto start = Clock::now();
     prepared.views = loader.load(f, pool);
 #ifdef TEGA_BENCH_HAVE_MVS
     if (!true_masks) {
@@ -270,8 +271,11 @@ int main(int argc, char** argv) {
 #endif
       mask_from_truth(prepared.views, root, rig, f, pool);
     prepared.times.load_s = seconds_since(start);
+    return prepared;
+  };
+  const auto prepare = [&](int, PreparedFrame prepared) {
     const std::vector<mvs::ViewTask> tasks = view_tasks(prepared.views, pm);
-    start = Clock::now();
+    const auto start = Clock::now();
     prepared.maps = mvs::estimate_depth_maps(prepared.views, tasks, pm, depth_device, &pool);
     prepared.times.depth_s = seconds_since(start);
     return prepared;
@@ -289,7 +293,7 @@ int main(int argc, char** argv) {
 #endif
   };
 
-  PreparedFrame one = prepare(frame);
+  PreparedFrame one = prepare(frame, load(frame));
   finish(one);
 
   // Depth maps against the true fine mesh.
@@ -326,19 +330,19 @@ int main(int argc, char** argv) {
   one = {};
 
   if (take_frames < 2) return 0;
-  // The take: frame n + 1 loads and gets its depth maps while frame n is
-  // fused and meshed. Its rate is the time between frames finishing.
+  // The take: frame n + 1 gets its depth maps and frame n + 2 loads while
+  // frame n is fused and meshed. Its rate is the time between frames finishing.
   std::vector<FrameTimes> times(static_cast<size_t>(take_frames));
   std::vector<double> finished_at(static_cast<size_t>(take_frames));
   std::vector<Mesh> meshes(static_cast<size_t>(take_frames));
   const auto take_start = Clock::now();
-  mvs::for_each_frame_overlapped(0, take_frames, prepare, [&](int f, PreparedFrame prepared) {
+  mvs::for_each_frame_pipelined(0, take_frames, load, prepare, [&](int f, PreparedFrame prepared) {
     finish(prepared);
     times[size_t(f)] = prepared.times;
     meshes[size_t(f)] = std::move(prepared.mesh);
     finished_at[size_t(f)] = seconds_since(take_start);
   });
-  std::printf("take of %d frames, overlapped (each stage's seconds include the other half's use of the CPU):\n"
+  std::printf("take of %d frames, pipelined (each stage's seconds include the other stages' use of the CPU):\n"
               "%-10s %8s %8s %8s %8s %10s\n",
               take_frames, "frame", "load", "depth", "fusion", "surface", "done at");
   for (int f = 0; f < take_frames; ++f) {

@@ -221,38 +221,54 @@ auto naming_the_frame(const std::string& label, Work&& work) {
   }
 }
 
-// A frame after its first half (views and depth maps); empty where an earlier run made it.
+// A frame's photos and masks; empty where an earlier run made it.
+struct LoadedFrame {
+  std::vector<StereoView> views;
+  double load_s = 0;
+  bool done_before = false;
+};
+
+// A frame with its depth maps; empty where an earlier run made it.
 struct PreparedFrame {
   std::vector<StereoView> views;
   FrameReconstruction reconstruction;
   bool done_before = false;
 };
 
-// Frames overlap (frame_pipeline.h): the next frame loads and gets its depth
-// maps, mostly on the GPU, while this one is fused, meshed and written on the
-// CPU. Both halves share the pool.
+// Frames in a pipeline (frame_pipeline.h): while this frame is fused, meshed
+// and written, the next gets its depth maps, mostly on the GPU, and the one
+// after loads. The stages share the pool.
 void reconstruct_frames(const TakeJob& job, const Options& options, MvsSummary& summary, ThreadPool& pool) {
   const TakeInfo& take = job.loader.take();
   fs::create_directories(job.out);
   Progress progress("mvs " + take.name, job.end - job.first, "frames");
-  const auto prepare = [&](int frame) {
-    PreparedFrame prepared;
+  const auto load = [&](int frame) {
+    LoadedFrame loaded;
     if (frame_done(job.out, frame, job.done_key)) {
-      prepared.done_before = true;
-      return prepared;
+      loaded.done_before = true;
+      return loaded;
     }
-    const std::string label = frame_label(take, frame);
-    return naming_the_frame(label, [&] {
+    return naming_the_frame(frame_label(take, frame), [&] {
       const auto start = Clock::now();
-      prepared.views = job.loader.load(frame, pool);
-      pool.parallel_for(0, int64_t(prepared.views.size()), [&](int64_t k) {
-        StereoView& view = prepared.views[size_t(k)];
+      loaded.views = job.loader.load(frame, pool);
+      pool.parallel_for(0, int64_t(loaded.views.size()), [&](int64_t k) {
+        StereoView& view = loaded.views[size_t(k)];
         const auto plate = job.plates.find(view.camera.name);
         if (plate != job.plates.end()) view.mask = subject_mask(view.colour, plate->second, options.mask);
       });
-      const double load_s = seconds_since(start);
+      loaded.load_s = seconds_since(start);
+      return std::move(loaded);
+    });
+  };
+  const auto prepare = [&](int frame, LoadedFrame loaded) {
+    PreparedFrame prepared;
+    prepared.done_before = loaded.done_before;
+    if (prepared.done_before) return prepared;
+    const std::string label = frame_label(take, frame);
+    return naming_the_frame(label, [&] {
+      prepared.views = std::move(loaded.views);
       prepared.reconstruction = estimate_depth(prepared.views, options, summary.device, label, pool);
-      prepared.reconstruction.timings.load_s = load_s;
+      prepared.reconstruction.timings.load_s = loaded.load_s;
       return std::move(prepared);
     });
   };
@@ -281,7 +297,7 @@ void reconstruct_frames(const TakeJob& job, const Options& options, MvsSummary& 
     ++summary.frames_done;
     progress.advance();
   };
-  for_each_frame_overlapped(job.first, job.end, prepare, finish);
+  for_each_frame_pipelined(job.first, job.end, load, prepare, finish);
   progress.finish();
 }
 
