@@ -133,8 +133,9 @@ OrientedPointCloud fuse_depth_maps(const std::vector<StereoView>& views, const s
     if (maps[k].width != view.camera.width || maps[k].height != view.camera.height)
       throw Error("fusion: the depth map of " + view.camera.name + " does not have the camera's size");
     if (view.camera.has_distortion()) throw Error("fusion: the camera of " + view.camera.name + " must be undistorted");
-    if (view.colour.empty() && view.grey.pixels.size() != size_t(view.camera.width) * view.camera.height)
-      throw Error("fusion: the view of " + view.camera.name + " has neither a colour nor a grey image of its size");
+    const size_t pixels = size_t(view.camera.width) * view.camera.height;
+    if (view.colour.empty() ? view.grey.pixels.size() != pixels : view.colour.pixels.size() != 3 * pixels)
+      throw Error("fusion: the view of " + view.camera.name + " has neither an RGB nor a grey image of its size");
     inputs.push_back(fusion_view(view, maps[k]));
   }
   std::optional<ThreadPool> own_pool;
