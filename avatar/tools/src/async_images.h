@@ -18,7 +18,7 @@ namespace tega::tools::detail {
 
 // Renders written as PNG (8-bit RGB, zlib level 1, as the capture writes) or EXR (float), a few
 // at a time. write() waits while as many files as there are threads are still in hand; finish()
-// waits for all. Either rethrows the first write's error (a tega::Error naming the file).
+// waits for all. Either rethrows the first failed write's error, which names the file.
 class BackgroundImageWriter {
  public:
   explicit BackgroundImageWriter(int threads = 0);  // 0: default_thread_count()
