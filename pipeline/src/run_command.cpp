@@ -9,9 +9,9 @@
 
 #include "available_commands.h"
 #include "commands.h"
-#include "tega/core/thread_pool.h"
 #include "tega/core/error.h"
 #include "tega/core/log.h"
+#include "tega/core/thread_pool.h"
 #include "tega/pipeline/gpus.h"
 #include "tega/pipeline/local_executor.h"
 #include "tega/pipeline/orchestrator.h"

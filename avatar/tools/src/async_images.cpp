@@ -33,20 +33,18 @@ void BackgroundImageWriter::write(const at::Tensor& rgb, const fs::path& file) {
 }
 
 void BackgroundImageWriter::submit(std::function<void()> task) {
-  while (pending_.size() >= static_cast<size_t>(pool_.size())) {
-    std::future<void> oldest = std::move(pending_.front());
-    pending_.pop_front();
-    oldest.get();
-  }
+  while (pending_.size() >= static_cast<size_t>(pool_.size())) wait_for_oldest();
   pending_.push_back(pool_.submit(std::move(task)));
 }
 
 void BackgroundImageWriter::finish() {
-  while (!pending_.empty()) {
-    std::future<void> oldest = std::move(pending_.front());
-    pending_.pop_front();
-    oldest.get();
-  }
+  while (!pending_.empty()) wait_for_oldest();
+}
+
+void BackgroundImageWriter::wait_for_oldest() {
+  std::future<void> oldest = std::move(pending_.front());
+  pending_.pop_front();
+  oldest.get();
 }
 
 ImagePrefetcher::ImagePrefetcher(std::vector<fs::path> files, int threads)

@@ -28,6 +28,7 @@ class BackgroundImageWriter {
 
  private:
   void submit(std::function<void()> task);
+  void wait_for_oldest();  // rethrows its error
 
   ThreadPool pool_;
   std::deque<std::future<void>> pending_;
