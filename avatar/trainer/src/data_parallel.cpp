@@ -8,19 +8,21 @@
 #include "tega/core/error.h"
 
 // libtorch's c10d: its stores always (the rendezvous and the host numbers), Gloo for gradients on
-// the CPU where its headers are (Debian: libgloo-dev), NCCL for gradients on GPUs where libtorch
-// was built with it (PyTorch's own libtorch; Debian's has no CUDA).
+// the CPU where its headers are (Debian: libgloo-dev). Gradients on GPUs go through NCCL's own API
+// (nccl_group.h) where CMake found NCCL beside a CUDA libtorch (Debian's has no CUDA).
 #if __has_include(<torch/csrc/distributed/c10d/FileStore.hpp>)
 #define TEGA_HAVE_C10D 1
 #include <torch/csrc/distributed/c10d/FileStore.hpp>
 #include <torch/csrc/distributed/c10d/PrefixStore.hpp>
 #include <torch/version.h>
-#if __has_include(<gloo/rendezvous/store.h>) && __has_include(<torch/csrc/distributed/c10d/ProcessGroupGloo.hpp>)
+#if defined(USE_C10D_GLOO) && __has_include(<gloo/rendezvous/store.h>) && \
+    __has_include(<torch/csrc/distributed/c10d/ProcessGroupGloo.hpp>)
 #define TEGA_HAVE_GLOO 1
 #include <torch/csrc/distributed/c10d/ProcessGroupGloo.hpp>
 #endif
-#ifdef USE_C10D_NCCL
-#include <torch/csrc/distributed/c10d/ProcessGroupNCCL.hpp>
+#ifdef TEGA_HAVE_NCCL
+#define TEGA_NCCL_GRADIENTS 1
+#include "nccl_group.h"
 #endif
 #endif
 
@@ -29,11 +31,13 @@ namespace tega::trainer {
 #ifdef TEGA_HAVE_C10D
 namespace {
 
-// What Gloo's and NCCL's groups derive from: c10d::ProcessGroup in libtorch 1.x, c10d::Backend in 2.x.
+#ifdef TEGA_HAVE_GLOO
+// What Gloo's group derives from: c10d::ProcessGroup in libtorch 1.x, c10d::Backend in 2.x.
 #if TORCH_VERSION_MAJOR >= 2
 using CollectiveGroup = c10d::Backend;
 #else
 using CollectiveGroup = c10d::ProcessGroup;
+#endif
 #endif
 
 // A process waits this long for the others (the first process's checkpoints and held-out renders
@@ -44,12 +48,17 @@ constexpr auto kPatience = std::chrono::minutes(30);
 
 struct DataParallel::Groups {
   c10::intrusive_ptr<c10d::Store> store;
-  c10::intrusive_ptr<CollectiveGroup> gradients;
+#ifdef TEGA_HAVE_GLOO
+  c10::intrusive_ptr<CollectiveGroup> cpu_gradients;
+#endif
+#ifdef TEGA_NCCL_GRADIENTS
+  std::unique_ptr<NcclGroup> gpu_gradients;
+#endif
   int64_t host_round = 0;
 };
 
 bool DataParallel::available(const at::Device& device) {
-#ifdef USE_C10D_NCCL
+#ifdef TEGA_NCCL_GRADIENTS
   if (device.is_cuda()) return true;
 #endif
 #ifdef TEGA_HAVE_GLOO
@@ -75,15 +84,17 @@ DataParallel::DataParallel(const ParallelRank& rank, const at::Device& device) :
   if (rank.rendezvous.empty()) throw Error("data-parallel training needs a rendezvous file");
   if (!available(device))
     throw Error(std::string("training on several processes needs libtorch's c10d with ") +
-                (device.is_cuda() ? "NCCL, which this libtorch lacks" : "Gloo's headers, which this build lacks (libgloo-dev)"));
+                (device.is_cuda() ? "NCCL, which this build lacks (CMake looks beside a CUDA libtorch, then in the system)" : "Gloo's headers, which this build lacks (libgloo-dev)"));
 #ifdef TEGA_HAVE_C10D
   groups_ = std::make_unique<Groups>();
   groups_->store = c10::make_intrusive<c10d::FileStore>(rank.rendezvous.string(), world_);
   groups_->store->setTimeout(kPatience);
   const auto gradient_store = c10::make_intrusive<c10d::PrefixStore>("gradients", groups_->store);
-#ifdef USE_C10D_NCCL
+#ifdef TEGA_NCCL_GRADIENTS
   if (device.is_cuda()) {
-    groups_->gradients = c10::make_intrusive<c10d::ProcessGroupNCCL>(gradient_store, rank_, world_);
+    // The first process makes the group's token; the others wait for it in the rendezvous.
+    if (rank_ == 0) gradient_store->set("nccl-token", NcclGroup::new_token());
+    groups_->gpu_gradients = std::make_unique<NcclGroup>(gradient_store->get("nccl-token"), rank_, world_, device);
     return;
   }
 #endif
@@ -91,7 +102,7 @@ DataParallel::DataParallel(const ParallelRank& rank, const at::Device& device) :
   auto options = c10d::ProcessGroupGloo::Options::create();
   options->devices.push_back(c10d::ProcessGroupGloo::createDeviceForHostname("127.0.0.1"));
   options->timeout = kPatience;
-  groups_->gradients = c10::make_intrusive<c10d::ProcessGroupGloo>(gradient_store, rank_, world_, options);
+  groups_->cpu_gradients = c10::make_intrusive<c10d::ProcessGroupGloo>(gradient_store, rank_, world_, options);
 #endif
 #endif
 }
@@ -99,11 +110,17 @@ DataParallel::DataParallel(const ParallelRank& rank, const at::Device& device) :
 // Alone, these are the identity (and without c10d no group exists beyond one process).
 void DataParallel::reduce(const std::vector<at::Tensor>& tensors, bool mean) {
   if (alone() || tensors.empty()) return;
-#ifdef TEGA_HAVE_C10D
+#ifdef TEGA_NCCL_GRADIENTS
+  if (groups_->gpu_gradients) {
+    groups_->gpu_gradients->all_reduce(tensors, mean);
+    return;
+  }
+#endif
+#ifdef TEGA_HAVE_GLOO
   std::vector<at::Tensor> flat_parts;
   for (const auto& t : tensors) flat_parts.push_back(t.reshape({-1}));
   std::vector<at::Tensor> flat{at::cat(flat_parts)};
-  groups_->gradients->allreduce(flat)->wait();
+  groups_->cpu_gradients->allreduce(flat)->wait();
   if (mean) flat[0].div_(world_);
   int64_t offset = 0;
   for (const auto& t : tensors) {

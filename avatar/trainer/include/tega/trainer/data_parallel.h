@@ -5,7 +5,7 @@
 // equal, as does every decision taken from them (densification, roll-backs, stopping).
 //
 // The processes meet through a rendezvous file (c10d's file store). The gradients go through a
-// collective group (NCCL for CUDA tensors where libtorch has it, Gloo on the CPU); the few numbers
+// collective group (NCCL for CUDA tensors where the build found it, Gloo on the CPU); the few numbers
 // every process must agree on go through the store itself, which never waits for a GPU stream.
 
 #include <ATen/ATen.h>

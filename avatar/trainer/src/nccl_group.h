@@ -1,0 +1,37 @@
+#pragma once
+// The gradients' all-reduce of a run trained on several GPUs (data_parallel.h), through NCCL's own
+// C API on each tensor's current CUDA stream. c10d's NCCL group would want them flattened into one
+// buffer and copied back (about 1 GB each way a step at 4M Gaussians); one NCCL group call reduces
+// each gradient in place, and averages in NCCL itself (ncclAvg).
+
+#include <ATen/ATen.h>
+
+#include <cstdint>
+#include <vector>
+
+struct ncclComm;
+
+namespace tega::trainer {
+
+class NcclGroup {
+ public:
+  // What every process of one group must be given: one process makes it, the others read it.
+  static std::vector<uint8_t> new_token();
+
+  // Joins the group on `device`; returns once all `world` processes have. Throws tega::Error.
+  NcclGroup(const std::vector<uint8_t>& token, int rank, int world, const at::Device& device);
+  ~NcclGroup();
+  NcclGroup(const NcclGroup&) = delete;
+  NcclGroup& operator=(const NcclGroup&) = delete;
+
+  // In place, each tensor (on this process's GPU) becomes its sum or mean over the processes. Queued
+  // on the current stream, in one NCCL group call, without a copy for contiguous tensors and without
+  // waiting on the host: later work on the stream sees the result.
+  void all_reduce(const std::vector<at::Tensor>& tensors, bool mean);
+
+ private:
+  ncclComm* communicator_ = nullptr;
+  at::Device device_;
+};
+
+}  // namespace tega::trainer

@@ -1,0 +1,56 @@
+// The gradients' all-reduce of training on several GPUs (NCCL), two GPUs driven by two threads of
+// this process; skips where there are fewer than two GPUs or the build has no NCCL.
+#include <ATen/ATen.h>
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "tega/trainer/data_parallel.h"
+#include "test_support.h"
+
+namespace tega::trainer {
+namespace {
+
+TEST(DataParallelCuda, AveragesAndSumsOverTwoGpusInPlace) {
+  if (!at::hasCUDA() || at::getNumGPUs() < 2) GTEST_SKIP() << "fewer than two GPUs";
+  if (!DataParallel::available(at::kCUDA)) GTEST_SKIP() << "this build has no NCCL";
+  test::TempDir dir;
+  constexpr int kWorld = 2;
+  at::Tensor gradient[kWorld], strided[kWorld], counts[kWorld];
+  const void* storage[kWorld];
+  double host[kWorld];
+  std::string failures[kWorld];
+  std::vector<std::thread> processes;
+  for (int rank = 0; rank < kWorld; ++rank) {
+    processes.emplace_back([&, rank] {
+      try {
+        const at::Device gpu(at::kCUDA, rank);
+        DataParallel parallel({rank, kWorld, dir / "rendezvous"}, gpu);
+        const auto on_gpu = at::TensorOptions().device(gpu);
+        gradient[rank] = at::full({1000, 59}, rank + 1.0f, on_gpu);  // 1 and 2: mean 1.5
+        storage[rank] = gradient[rank].data_ptr();
+        strided[rank] = (at::arange(12, on_gpu.dtype(at::kFloat)) * (rank == 0 ? 1 : 3)).view({3, 4}).t();
+        counts[rank] = at::full({6}, rank == 0 ? 2.0 : 5.0, on_gpu.dtype(at::kDouble));
+        parallel.average({gradient[rank], strided[rank]});
+        parallel.sum({counts[rank]});
+        host[rank] = parallel.host_sum({rank + 1.0})[0];
+        parallel.barrier();
+      } catch (const std::exception& e) {
+        failures[rank] = e.what();
+      }
+    });
+  }
+  for (auto& p : processes) p.join();
+  for (int rank = 0; rank < kWorld; ++rank) {
+    ASSERT_EQ(failures[rank], "") << "GPU " << rank;
+    EXPECT_EQ(gradient[rank].data_ptr(), storage[rank]) << "reduced in place";
+    EXPECT_TRUE(at::equal(gradient[rank].cpu(), at::full({1000, 59}, 1.5f)));
+    EXPECT_FALSE(strided[rank].is_contiguous());
+    EXPECT_TRUE(at::equal(strided[rank].cpu(), (at::arange(12, at::kFloat) * 2).view({3, 4}).t())) << strided[rank];
+    EXPECT_TRUE(at::equal(counts[rank].cpu(), at::full({6}, 7.0, at::kDouble)));
+    EXPECT_EQ(host[rank], 3.0);
+  }
+}
+
+}  // namespace
+}  // namespace tega::trainer
