@@ -1,7 +1,8 @@
 // scripts/ablation-study end to end on a tiny CPU study: a capture of the
-// procedural head, two of the paper's rows and one row of the user's own
-// (ROWS_FILE), two seeds, a curve of two points (so every run resumes once), the
-// table over seeds and the liveness of each run against the true meshes.
+// procedural head, two of the paper's rows, one row of the user's own
+// (ROWS_FILE) and one row trained by two processes at once (MULTI_GPU_ROWS), two
+// seeds, a curve of two points (so every run resumes once), the table over seeds
+// and the liveness of each run against the true meshes.
 
 #include <gtest/gtest.h>
 
@@ -37,14 +38,25 @@ TEST(AblationStudy, TrainsEveryRowAndSeedThenTabulatesAndInspectsThem) {
   TempDir tmp;
   write_text(tmp / "rows", "# a row of the user's own\npyramid --set loss.pyramid_l1=1 --set loss.pyramid_levels=2\n");
   const auto r = run_command(tiny_study_environment(tmp) + "GPUS='0 1' VARIANTS='full gaussian-avatars' ROWS_FILE=" +
-                             (tmp / "rows").string() + " bash " + kScript + " " + (tmp / "study").string());
+                             (tmp / "rows").string() + " MULTI_GPU_ROWS=full MULTI_GPU=2 bash " + kScript + " " +
+                             (tmp / "study").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
 
   const nlohmann::json eval = nlohmann::json::parse(read_text_file(tmp / "study/eval.json"));
   std::set<std::string> names;
   for (const auto& model : eval.at("models")) names.insert(model.at("name").get<std::string>());
   EXPECT_EQ(names, (std::set<std::string>{"full.s0", "full.s1", "gaussian-avatars.s0", "gaussian-avatars.s1",
-                                          "pyramid.s0", "pyramid.s1"}));
+                                          "pyramid.s0", "pyramid.s1", "full-x2.s0", "full-x2.s1"}));
+  // The row on two processes: half the steps, two views each, so the same views as full's 12
+  // iterations (and 3 of its 6 at the curve's first point); the processes' parameters agreed.
+  for (const char* seed : {"s0", "s1"}) {
+    const std::string run = std::string("study/runs/full-x2.") + seed;
+    EXPECT_EQ(nlohmann::json::parse(read_text_file(tmp / run / "run.json")).at("iterations").get<int>(), 6) << run;
+    const std::string log = read_text_file(tmp / (std::string("study/logs/full-x2.") + seed + ".log"));
+    EXPECT_NE(log.find("full-x2." + std::string(seed) + " to iteration 3 on GPU 0,1"), std::string::npos) << log;
+    EXPECT_NE(log.find("2 processes trained one model: their parameters agree"), std::string::npos) << log;
+  }
+  EXPECT_NE(read_text_file(tmp / "study/eval-6/full-x2.s0.md").find("full-x2.s0"), std::string::npos);
   EXPECT_TRUE(std::filesystem::exists(tmp / "study/table-6.md"));  // the curve's first point
   // Each run evaluated on its own, then merged.
   EXPECT_EQ(nlohmann::json::parse(read_text_file(tmp / "study/eval-12/pyramid.s1.json")).at("models").size(), 1u);
@@ -52,7 +64,7 @@ TEST(AblationStudy, TrainsEveryRowAndSeedThenTabulatesAndInspectsThem) {
   const std::string table = read_text_file(tmp / "study/table.md");
   EXPECT_NE(table.find("(iteration 12)"), std::string::npos) << table;
   EXPECT_NE(table.find("Seeds 0, 1."), std::string::npos) << table;
-  for (const char* row : {"| full |", "| gaussian-avatars |", "| pyramid |"})
+  for (const char* row : {"| full |", "| gaussian-avatars |", "| pyramid |", "| full-x2 |"})
     EXPECT_NE(table.find(row), std::string::npos) << row << "\n" << table;
 
   // Round robin over GPUS, rows x seeds in order (on the CPU the device index only names the run's share).
@@ -69,7 +81,7 @@ TEST(AblationStudy, TrainsEveryRowAndSeedThenTabulatesAndInspectsThem) {
   const std::string liveness = read_text_file(tmp / "study/liveness.md");
   std::size_t previous = 0;
   for (const char* run : {"## full.s0", "## full.s1", "## gaussian-avatars.s0", "## gaussian-avatars.s1",
-                          "## pyramid.s0", "## pyramid.s1"}) {
+                          "## pyramid.s0", "## pyramid.s1", "## full-x2.s0", "## full-x2.s1"}) {
     const std::size_t at = liveness.find(run);
     ASSERT_NE(at, std::string::npos) << run << "\n" << liveness;
     EXPECT_GT(at, previous) << run << "\n" << liveness;
@@ -78,7 +90,7 @@ TEST(AblationStudy, TrainsEveryRowAndSeedThenTabulatesAndInspectsThem) {
   EXPECT_EQ(liveness.find("# Liveness of each part"), liveness.rfind("# Liveness of each part")) << liveness;
   EXPECT_NE(liveness.find("against the true meshes"), std::string::npos) << liveness;
   const nlohmann::json inspected = nlohmann::json::parse(read_text_file(tmp / "study/liveness.json"));
-  ASSERT_EQ(inspected.size(), 6u);
+  ASSERT_EQ(inspected.size(), 8u);
   EXPECT_EQ(inspected.at(1).at("run").get<std::string>(), (tmp / "study/runs/full.s1").string());
 }
 
@@ -131,6 +143,27 @@ TEST(AblationStudy, ARowOfTheRowsFileMustBeNewAndWellNamed) {
   r = run_command("ROWS_FILE=" + (tmp / "nowhere").string() + " " + study);
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("ROWS_FILE: no file"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(tmp / "study/capture"));  // refused before any work
+}
+
+TEST(AblationStudy, MultiGpuRowsAreRowsOfTheStudyOnEnoughGpus) {
+  TempDir tmp;
+  const std::string study = "VARIANTS='full gaussian-avatars' bash " + kScript + " " + (tmp / "study").string();
+  auto r = run_command("MULTI_GPU_ROWS=no-warp " + study);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("MULTI_GPU_ROWS: 'no-warp' is not a row of the study"), std::string::npos) << r.output;
+
+  r = run_command("MULTI_GPU_ROWS=full GPUS='0 1' " + study);  // MULTI_GPU 4 by default
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("GPUS lists 2 device(s), fewer than MULTI_GPU=4"), std::string::npos) << r.output;
+
+  r = run_command("MULTI_GPU_ROWS=full MULTI_GPU=1 " + study);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("MULTI_GPU: '1' is not a number of GPUs above 1"), std::string::npos) << r.output;
+
+  r = run_command("MULTI_GPU_ROWS='full full' MULTI_GPU=2 " + study);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("MULTI_GPU_ROWS: 'full' twice"), std::string::npos) << r.output;
   EXPECT_FALSE(std::filesystem::exists(tmp / "study/capture"));  // refused before any work
 }
 
