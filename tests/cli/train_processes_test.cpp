@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
+#include <regex>
 
 #include "cli_support.h"
 #include "test_support.h"
@@ -41,6 +43,54 @@ TEST(CliTrain, TwoProcessesTrainOneModelAndAgree) {
   const auto cpu_gpus = run_tega(train + " --force --gpus 0,1");
   EXPECT_NE(cpu_gpus.exit_code, 0);
   EXPECT_NE(cpu_gpus.output.find("--gpus trains on GPUs: pass --device cuda"), std::string::npos) << cpu_gpus.output;
+}
+
+// The checksum the processes agreed on at the end of a run, or NaN where they did not say.
+double agreed_checksum(const std::string& output) {
+  std::smatch m;
+  static const std::regex agreed(R"(their parameters agree \(checksum ([0-9.e+-]+)\))");
+  return std::regex_search(output, m, agreed) ? std::stod(m[1]) : std::nan("");
+}
+
+// SIGTERM to `tega train --processes 2` (as `tega run` or a scheduler sends it) stops both processes
+// at one step with a checkpoint; resumed, the run goes on as if it had never stopped.
+TEST(CliTrain, TwoProcessesStopTogetherOnSigtermAndResumeAsIfUninterrupted) {
+  if (run_tega("train --help").exit_code != 0) GTEST_SKIP() << "this tega has no train command (no libtorch)";
+  TempDir tmp;
+  const auto synth = run_tega("synth --out " + (tmp / "capture").string() +
+                              " --set studio.width=96 --set studio.height=64 --set frames=3 --set calibration_frames=0");
+  ASSERT_EQ(synth.exit_code, 0) << synth.output;
+  const auto train = [&](const std::string& run) {
+    return std::string(TEGA_EXECUTABLE) + " train --data " + (tmp / "capture/dataset").string() + " --out " +
+           (tmp / run).string() +
+           " --processes 2 --iterations 300 --set log_every=2 --set uv_lookup.resolution=64"
+           " --set network.texture_size=16 --set network.unet_widths=[4,8] --set network.latent_channels=4"
+           " --set network.mlp_hidden=8 --set initial_gaussians=400 --set densify.enabled=false";
+  };
+  const auto straight = run_command(train("straight") + " --stop-at 100 2>&1");
+  if (straight.output.find("needs libtorch's c10d") != std::string::npos) GTEST_SKIP() << "no c10d with Gloo";
+  ASSERT_EQ(straight.exit_code, 0) << straight.output;
+
+  // Stopped once the run is under way (a few hundredths of a second an iteration here).
+  const std::string log = (tmp / "stopped.log").string();
+  const auto stopped = run_command("bash -c '" + train("stopped") + " >" + log + " 2>&1 & pid=$!; " +
+                                   "for i in $(seq 1200); do grep -q \" it 10/300\" " + log +
+                                   " && break; sleep 0.05; done; kill -TERM $pid; wait $pid; echo exit=$?; cat " +
+                                   log + "'");
+  EXPECT_NE(stopped.output.find("exit=130"), std::string::npos) << stopped.output;
+  std::smatch at;
+  ASSERT_TRUE(std::regex_search(stopped.output, at, std::regex(R"(interrupted after (\d+) of 300 iterations)")))
+      << stopped.output;
+  const int stopped_at = std::stoi(at[1]);
+  ASSERT_GE(stopped_at, 10);
+  ASSERT_LT(stopped_at, 100) << "the run got too far before the signal to test its resumption";
+  // Both processes stopped at that step: their parameters agree in the checkpoint they saved.
+  EXPECT_FALSE(std::isnan(agreed_checksum(stopped.output))) << stopped.output;
+
+  const auto resumed = run_command(train("stopped") + " --resume --stop-at 100 2>&1");
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  const double expected = agreed_checksum(straight.output), got = agreed_checksum(resumed.output);
+  EXPECT_NEAR(got, expected, 1e-6 * std::abs(expected)) << straight.output << "\n" << resumed.output;
 }
 
 }  // namespace
