@@ -13,11 +13,15 @@
 namespace tega::test {
 namespace {
 
+CommandResult render_tiny_capture(const std::filesystem::path& capture) {
+  return run_tega("synth --out " + capture.string() +
+                  " --set studio.width=96 --set studio.height=64 --set frames=3 --set calibration_frames=0");
+}
+
 TEST(CliTrain, TwoProcessesTrainOneModelAndAgree) {
   if (run_tega("train --help").exit_code != 0) GTEST_SKIP() << "this tega has no train command (no libtorch)";
   TempDir tmp;
-  const auto synth = run_tega("synth --out " + (tmp / "capture").string() +
-                              " --set studio.width=96 --set studio.height=64 --set frames=3 --set calibration_frames=0");
+  const auto synth = render_tiny_capture(tmp / "capture");
   ASSERT_EQ(synth.exit_code, 0) << synth.output;
   const std::string train = "train --data " + (tmp / "capture/dataset").string() + " --out " + (tmp / "run").string() +
                             " --iterations 16 --set log_every=4 --set uv_lookup.resolution=64"
@@ -57,8 +61,7 @@ double agreed_checksum(const std::string& output) {
 TEST(CliTrain, TwoProcessesStopTogetherOnSigtermAndResumeAsIfUninterrupted) {
   if (run_tega("train --help").exit_code != 0) GTEST_SKIP() << "this tega has no train command (no libtorch)";
   TempDir tmp;
-  const auto synth = run_tega("synth --out " + (tmp / "capture").string() +
-                              " --set studio.width=96 --set studio.height=64 --set frames=3 --set calibration_frames=0");
+  const auto synth = render_tiny_capture(tmp / "capture");
   ASSERT_EQ(synth.exit_code, 0) << synth.output;
   const auto train = [&](const std::string& run) {
     return std::string(TEGA_EXECUTABLE) + " train --data " + (tmp / "capture/dataset").string() + " --out " +

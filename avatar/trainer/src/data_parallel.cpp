@@ -84,7 +84,8 @@ DataParallel::DataParallel(const ParallelRank& rank, const at::Device& device) :
   if (rank.rendezvous.empty()) throw Error("data-parallel training needs a rendezvous file");
   if (!available(device))
     throw Error(std::string("training on several processes needs libtorch's c10d with ") +
-                (device.is_cuda() ? "NCCL, which this build lacks (CMake looks beside a CUDA libtorch, then in the system)" : "Gloo's headers, which this build lacks (libgloo-dev)"));
+                (device.is_cuda() ? "NCCL, which this build lacks (CMake looks beside a CUDA libtorch, then in the system)"
+                                  : "Gloo's headers, which this build lacks (libgloo-dev)"));
 #ifdef TEGA_HAVE_C10D
   groups_ = std::make_unique<Groups>();
   groups_->store = c10::make_intrusive<c10d::FileStore>(rank.rendezvous.string(), world_);

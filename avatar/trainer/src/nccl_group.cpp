@@ -14,8 +14,10 @@ namespace {
 
 void check(ncclResult_t result, const char* call, ncclComm_t communicator = nullptr) {
   if (result == ncclSuccess) return;
-  std::string message = std::string("data-parallel training: NCCL's ") + call + " failed: " + ncclGetErrorString(result);
-  if (const char* detail = ncclGetLastError(communicator); detail && *detail) message += std::string(" (") + detail + ")";
+  std::string message =
+      std::string("data-parallel training: NCCL's ") + call + " failed: " + ncclGetErrorString(result);
+  if (const char* detail = ncclGetLastError(communicator); detail && *detail)
+    message += std::string(" (") + detail + ")";
   throw Error(message);
 }
 
