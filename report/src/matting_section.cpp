@@ -59,10 +59,12 @@ void score_take(const std::string& stage_name, const fs::path& mattes, const std
   const scoring::MatteScores s = scoring::score_mattes(mattes, context.subject.truth, take);
   Table table{{"measure", "mean", "worst image", "target"}, {}};
   const std::string stage = stage_name + " (" + take + ")";
-  table.rows.push_back({"|alpha error|", fixed(s.mean_error, 4), fixed(s.worst_mean_error, 4), "<= 0.02 per image"});
+  const auto worst = [](const std::string& value, const std::string& image) { return value + " (" + image + ")"; };
+  table.rows.push_back({"|alpha error|", fixed(s.mean_error, 4), worst(fixed(s.worst_mean_error, 4), s.worst_mean_image),
+                        "<= 0.02 per image"});
   table.rows.push_back({"|alpha error| within 3 px of the edge", fixed(s.boundary_error, 3),
-                        fixed(s.worst_boundary_error, 3), "<= 0.1"});
-  table.rows.push_back({"silhouette IoU", fixed(s.iou, 4), fixed(s.worst_iou, 4), ">= 0.98"});
+                        worst(fixed(s.worst_boundary_error, 3), s.worst_boundary_image), "<= 0.1"});
+  table.rows.push_back({"silhouette IoU", fixed(s.iou, 4), worst(fixed(s.worst_iou, 4), s.worst_iou_image), ">= 0.98"});
   context.scores.push_back({stage, "alpha error, worst image", fixed(s.worst_mean_error, 4), "<= 0.02",
                             verdict(s.worst_mean_error <= 0.02)});
   context.scores.push_back({stage, "alpha error near the edge, worst image", fixed(s.worst_boundary_error, 3), "<= 0.1",

@@ -64,14 +64,17 @@ MatteScores score_mattes(const fs::path& mattes, const fs::path& capture, const 
 
   MatteScores scores;
   scores.worst_iou = 1;
-  for (const ImageScores& image : per_image) {
+  for (size_t i = 0; i < per_image.size(); ++i) {
+    const ImageScores& image = per_image[i];
+    const std::string name = (files[i].parent_path().filename() / files[i].filename()).string();
     ++scores.images;
     scores.mean_error += image.mean;
     scores.boundary_error += image.boundary;
     scores.iou += image.iou;
-    scores.worst_mean_error = std::max(scores.worst_mean_error, image.mean);
-    scores.worst_boundary_error = std::max(scores.worst_boundary_error, image.boundary);
-    scores.worst_iou = std::min(scores.worst_iou, image.iou);
+    if (image.mean >= scores.worst_mean_error) scores.worst_mean_error = image.mean, scores.worst_mean_image = name;
+    if (image.boundary >= scores.worst_boundary_error)
+      scores.worst_boundary_error = image.boundary, scores.worst_boundary_image = name;
+    if (image.iou <= scores.worst_iou) scores.worst_iou = image.iou, scores.worst_iou_image = name;
   }
   scores.mean_error /= scores.images;
   scores.boundary_error /= scores.images;

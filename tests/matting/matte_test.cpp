@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <opencv2/imgproc.hpp>
 
 #include "cli_support.h"
 #include "small_studio.h"
@@ -85,6 +86,26 @@ TEST_F(Matte, MeetsTheTargetsWithAMeshMillimetresOff) {
   const MatteSummary again = matte_capture({capture(), tracked(), out("mattes"), {}, {}}, options());
   EXPECT_EQ(again.images, 0);
   EXPECT_EQ(again.images_kept, 13 * kFrames);
+}
+
+TEST_F(Matte, ScoresNameTheWorstImage) {
+  // The true alpha as mattes, but for one camera's frame 1, spoiled along its edge by a blur.
+  const fs::path mattes = out("mattes_truth"), truth = capture() / "ground_truth" / "expressions" / "alpha";
+  fs::create_directories(mattes / "expressions");
+  fs::copy(truth, mattes / "expressions", fs::copy_options::recursive);
+  const TakeInfo take = read_take(capture() / "takes" / "expressions");
+  const std::string camera = take.cameras[5];
+  const fs::path spoiled = mattes / "expressions" / camera / "000001.png";
+  Image8 alpha = read_image_u8(spoiled);
+  cv::Mat view(alpha.height, alpha.width, CV_8U, alpha.pixels.data());
+  cv::GaussianBlur(view, view, cv::Size(9, 9), 3);
+  write_image(alpha, spoiled);
+
+  const scoring::MatteScores s = scoring::score_mattes(mattes, capture(), "expressions");
+  EXPECT_GT(s.worst_boundary_error, 0.05);
+  EXPECT_EQ(s.worst_boundary_image, camera + "/000001.png");
+  EXPECT_EQ(s.worst_mean_image, camera + "/000001.png");
+  EXPECT_EQ(s.worst_iou_image, camera + "/000001.png");
 }
 
 TEST_F(Matte, FollowsAnExposureDrift) {

@@ -12,6 +12,8 @@ struct MatteScores {
   double mean_error = 0, worst_mean_error = 0;          // mean |alpha - true| per image (0..1): mean, worst image
   double boundary_error = 0, worst_boundary_error = 0;  // same within `boundary_px` of the true edge
   double iou = 0, worst_iou = 0;                        // silhouettes (alpha >= 0.5): mean, worst image
+  // Which image is worst by each measure, as <camera>/<frame file>, so that it can be looked at.
+  std::string worst_mean_image, worst_boundary_image, worst_iou_image;
 };
 
 // Every matte of MATTES/<take>/ against the truth of `capture`. The true edge
