@@ -296,9 +296,16 @@ Image8 matte_at_this_size(const Image8& photo, const Plate* plate, const Image8&
   subject = connected_subject(subject, certain, possible, options.mesh.keep_connected_only && cv::countNonZero(certain) > 0);
 
   // The band around the edge, where alpha is fractional; the work stays in
-  // its bounding box.
-  const cv::Mat band_mask =
+  // its bounding box. Subject within `band` of the photo's border is in it
+  // too: the 3 x 3 difference and the closing carry the subject onto the
+  // last pixels whatever they show, so an edge lying there (a bust cut just
+  // above the frame's bottom) is decided by unmixing like any other.
+  cv::Mat band_mask =
       ((distance_inside(subject) <= band) & subject) | ((distance_outside(subject) <= band) & (subject == 0));
+  cv::Mat near_border(subject.size(), CV_8U, cv::Scalar(255));
+  if (subject.cols > 2 * band && subject.rows > 2 * band)
+    near_border(cv::Rect(band, band, subject.cols - 2 * band, subject.rows - 2 * band)).setTo(0);
+  band_mask |= near_border & subject;
   cv::Mat alpha;
   subject.convertTo(alpha, CV_32F, 1.0 / 255);
   const cv::Rect box = cv::boundingRect(band_mask);

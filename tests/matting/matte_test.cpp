@@ -166,6 +166,33 @@ TEST(MatteAtTheStudiosSize, MeetsTheTargetsMattedAtFullSize) {
   EXPECT_GT(half.worst_boundary_error, full.worst_boundary_error);
 }
 
+// A bust cut two pixels above the photo's bottom (as the frontal camera sees
+// the virtual studio's at 3072 x 2048): the 3 x 3 difference and the closing
+// carry the subject onto those rows, which show the backdrop; unmixed against
+// the plate, they are background again.
+TEST(MatteAtThePhotosBorder, AnEdgeJustInsideTheFrameIsUnmixed) {
+  const int width = 160, height = 96, bottom = height - 2;  // the bust covers rows [30, bottom)
+  Image8 plate(width, height, 3, 0);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      for (int c = 0; c < 3; ++c) plate.at(x, y, c) = uint8_t(60 + 10 * c + (x * 7 + y * 3) % 5);
+  Image8 photo = plate, silhouette(width, height, 1, 0);
+  const cv::Rect bust(40, 30, 80, bottom - 30);
+  for (int y = bust.y; y < bust.y + bust.height; ++y) {
+    for (int x = bust.x; x < bust.x + bust.width; ++x) {
+      const uint8_t skin[3] = {230, 175, 145};
+      for (int c = 0; c < 3; ++c) photo.at(x, y, c) = skin[c];
+      silhouette.at(x, y, 0) = 255;
+    }
+  }
+  const Image8 alpha = compute_matte(photo, &plate, silhouette, 4, MatteOptions());
+  for (int x = bust.x + 4; x < bust.x + bust.width - 4; ++x) {
+    EXPECT_GE(alpha.at(x, bottom - 1, 0), 250) << "x " << x;
+    EXPECT_LE(alpha.at(x, bottom, 0), 10) << "x " << x;
+    EXPECT_LE(alpha.at(x, height - 1, 0), 10) << "x " << x;
+  }
+}
+
 TEST_F(Matte, FallsBackOnTheMeshWithoutACleanPlate) {
   MatteOptions o = options();
   o.use_clean_plate = false;
