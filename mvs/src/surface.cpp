@@ -124,7 +124,7 @@ Mesh reconstruct_surface(const OrientedPointCloud& cloud, const SurfaceOptions& 
   const open3d::geometry::PointCloud points = to_open3d(cloud);
   auto [mesh, densities] = open3d::geometry::TriangleMesh::CreateFromPointCloudPoisson(
       points, size_t(options.poisson_depth), 0.0f, float(options.poisson_scale), false,
-      options.threads > 0 ? options.threads : -1);
+      options.poisson_threads > 0 ? options.poisson_threads : -1);
   const double poisson_s = seconds_since(start);
 
   const open3d::geometry::KDTreeFlann tree(points);

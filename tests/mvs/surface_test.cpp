@@ -51,6 +51,21 @@ TEST(Surface, SphereCloudGivesAClosedOutwardSphere) {
   EXPECT_EQ(inward, 0);
 }
 
+// Poisson on one thread (the default): a frame meshed again, as a resumed
+// take does, gives the same mesh.
+TEST(Surface, TheSameCloudGivesTheSameMesh) {
+  SurfaceOptions options = test_options();
+  options.threads = 0;
+  const OrientedPointCloud cloud = test::sphere_cloud(20000, kRadius, 0.0);
+  const Mesh first = reconstruct_surface(cloud, options);
+  for (int again = 0; again < 3; ++again) {
+    const Mesh mesh = reconstruct_surface(cloud, options);
+    ASSERT_EQ(mesh.num_faces(), first.num_faces());
+    EXPECT_EQ(mesh.positions, first.positions);
+    EXPECT_EQ(mesh.faces, first.faces);
+  }
+}
+
 TEST(Surface, HemisphereCloudIsTrimmedToTheHemisphere) {
   const Mesh mesh = reconstruct_surface(test::sphere_cloud(20000, kRadius, 0.0), test_options());
   ASSERT_GT(mesh.num_faces(), 5000);

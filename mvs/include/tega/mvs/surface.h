@@ -18,7 +18,12 @@ struct SurfaceOptions {
   double trim_distance_m = 0.003;
   // Connected components with fewer faces than this share of the largest are removed.
   double min_component_share = 0.05;
-  int threads = 0;  // 0: one per hardware thread (OpenMP: on a busy machine, fewer is faster)
+  int threads = 0;  // trimming and orientation; 0: one per hardware thread
+  // Open3D 0.16's Poisson splats the points on several threads with a race:
+  // now and then it crashes (a segfault in FEMTree::_splatPointData, more
+  // often on a busy machine) and its meshes differ from run to run. On one
+  // thread it is neither, and at depth 8 about as fast (docs/mvs.md).
+  int poisson_threads = 1;
 
   template <class V>
   void visit(V& v) {
@@ -29,7 +34,10 @@ struct SurfaceOptions {
     v("trim_distance_m", trim_distance_m, "Remove faces farther than this from every point, in metres (0: off).");
     v("min_component_share", min_component_share,
       "Remove connected components smaller than this share of the largest (in faces).");
-    v("threads", threads, "Worker threads (0: one per hardware thread).");
+    v("threads", threads, "Worker threads of the trimming and orientation (0: one per hardware thread).");
+    v("poisson_threads", poisson_threads,
+      "Threads of Open3D's Poisson solver (0: one per hardware thread). More than one can crash now and then "
+      "(a race in Open3D 0.16's PoissonRecon) and makes the mesh differ from run to run.");
   }
 };
 
