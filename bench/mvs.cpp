@@ -147,7 +147,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Multi-view stereo time and accuracy on one virtual-studio frame."};
   int cameras = 13, width = 512, height = 384, frame = 0, threads = 0, window_radius = 0, window_step = 0,
       fusion_step = 0, iterations = 0, geometric_iterations = 0, pyramid_levels = -1, refine_passes = -1,
-      refine_iterations = 0, poisson_depth = 0, surface_threads = 0, take_frames = 0;
+      refine_iterations = 0, poisson_depth = 0, surface_threads = 0, poisson_threads = 0, take_frames = 0;
   double voxel_size = 0;
   std::string cloud_file;
   bool verbose = false;
@@ -186,6 +186,7 @@ int main(int argc, char** argv) {
 #endif
   app.add_option("--poisson-depth", poisson_depth, "Poisson octree depth (default: the options'; needs Open3D).");
   app.add_option("--surface-threads", surface_threads, "Threads of the surface stage (default: the options', else --threads).");
+  app.add_option("--poisson-threads", poisson_threads, "Threads of Poisson itself (default: the options', 1).");
 #ifdef TEGA_BENCH_HAVE_SURFACE
   app.add_option("--cloud", cloud_file,
                  "Mesh and score this fused cloud of the frame (e.g. one the GPU machine made) instead of making one.");
@@ -226,6 +227,7 @@ int main(int argc, char** argv) {
 #ifdef TEGA_BENCH_HAVE_SURFACE
   if (poisson_depth > 0) surface_options.poisson_depth = poisson_depth;
   if (surface_threads > 0) surface_options.threads = surface_threads;
+  if (poisson_threads > 0) surface_options.poisson_threads = poisson_threads;
 #endif
   if (device == "cuda" && !mvs::cuda_device_available()) {
     std::fprintf(stderr, "mvs_bench: no CUDA device\n");
@@ -240,8 +242,9 @@ int main(int argc, char** argv) {
     const Mesh mesh = mvs::reconstruct_surface(cloud, surface_options);
     const double surface_s = seconds_since(start);
     report_mesh(mesh, root, frame);
-    std::printf("%s: %d points; surface (Poisson depth %d) %.2f s on %d threads\n", cloud_file.c_str(), cloud.size(),
-                surface_options.poisson_depth, surface_s, surface_options.threads);
+    std::printf("%s: %d points; surface (Poisson depth %d on %d threads, the rest on %d) %.2f s\n", cloud_file.c_str(),
+                cloud.size(), surface_options.poisson_depth, surface_options.poisson_threads, surface_options.threads,
+                surface_s);
     return 0;
   }
 #endif
