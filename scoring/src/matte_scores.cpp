@@ -71,10 +71,18 @@ MatteScores score_mattes(const fs::path& mattes, const fs::path& capture, const 
     scores.mean_error += image.mean;
     scores.boundary_error += image.boundary;
     scores.iou += image.iou;
-    if (image.mean >= scores.worst_mean_error) scores.worst_mean_error = image.mean, scores.worst_mean_image = name;
-    if (image.boundary >= scores.worst_boundary_error)
-      scores.worst_boundary_error = image.boundary, scores.worst_boundary_image = name;
-    if (image.iou <= scores.worst_iou) scores.worst_iou = image.iou, scores.worst_iou_image = name;
+    if (image.mean >= scores.worst_mean_error) {
+      scores.worst_mean_error = image.mean;
+      scores.worst_mean_image = name;
+    }
+    if (image.boundary >= scores.worst_boundary_error) {
+      scores.worst_boundary_error = image.boundary;
+      scores.worst_boundary_image = name;
+    }
+    if (image.iou <= scores.worst_iou) {
+      scores.worst_iou = image.iou;
+      scores.worst_iou_image = name;
+    }
   }
   scores.mean_error /= scores.images;
   scores.boundary_error /= scores.images;
