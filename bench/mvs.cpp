@@ -141,6 +141,28 @@ std::vector<mvs::ViewTask> view_tasks(const std::vector<mvs::StereoView>& views,
   return tasks;
 }
 
+#if defined(TEGA_BENCH_HAVE_MVS) && defined(TEGA_BENCH_HAVE_SURFACE)
+// The views and depth maps of a frame's dense workspace (`tega mvs
+// --workspace`), fused again: fusion tuned without making the depth maps.
+mvs::OrientedPointCloud fuse_workspace(const fs::path& directory, const mvs::FusionOptions& options, ThreadPool& pool) {
+  const mvs::DenseWorkspace workspace = mvs::read_dense_workspace(directory);
+  std::vector<mvs::StereoView> views;
+  std::vector<mvs::DepthMap> maps;
+  std::vector<int> map_views;
+  for (const auto& [name, image] : workspace.images) {
+    mvs::StereoView view;
+    view.camera = workspace.rig.camera(name);
+    view.colour = image;
+    views.push_back(std::move(view));
+    if (const auto found = workspace.depth_maps.find(name); found != workspace.depth_maps.end()) {
+      map_views.push_back(int(views.size()) - 1);
+      maps.push_back(found->second);
+    }
+  }
+  return mvs::fuse_depth_maps(views, map_views, maps, options, &pool);
+}
+#endif
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -149,7 +171,7 @@ int main(int argc, char** argv) {
       fusion_step = 0, iterations = 0, geometric_iterations = 0, pyramid_levels = -1, refine_passes = -1,
       refine_iterations = 0, poisson_depth = 0, surface_threads = 0, poisson_threads = 0, take_frames = 0;
   double voxel_size = 0;
-  std::string cloud_file;
+  std::string cloud_file, workspace;
   bool verbose = false;
   std::string device = "cpu", capture = (fs::temp_directory_path() / "tega-mvs-bench").string(), out, config,
               meshes_out;
@@ -190,6 +212,11 @@ int main(int argc, char** argv) {
 #ifdef TEGA_BENCH_HAVE_SURFACE
   app.add_option("--cloud", cloud_file,
                  "Mesh and score this fused cloud of the frame (e.g. one the GPU machine made) instead of making one.");
+#ifdef TEGA_BENCH_HAVE_MVS
+  app.add_option("--workspace", workspace,
+                 "Fuse the frame's dense workspace that tega mvs --workspace wrote (MESHES/<take>/colmap/<frame>/) "
+                 "again with these options, then mesh and score it: fusion tuned without making the depth maps.");
+#endif
 #endif
   CLI11_PARSE(app, argc, argv);
   init_logging(verbose ? 2 : 1);
@@ -236,6 +263,18 @@ int main(int argc, char** argv) {
 
 #ifdef TEGA_BENCH_HAVE_SURFACE
   if (surface_options.threads == 0) surface_options.threads = pool.size();
+#ifdef TEGA_BENCH_HAVE_MVS
+  if (!workspace.empty()) {
+    const auto start = Clock::now();
+    const mvs::OrientedPointCloud cloud = fuse_workspace(workspace, fusion_options, pool);
+    const double fusion_s = seconds_since(start);
+    const Mesh mesh = mvs::reconstruct_surface(cloud, surface_options);
+    report_mesh(mesh, root, frame);
+    std::printf("%s: fused again into %d points in %.2f s, meshed in %.2f s\n", workspace.c_str(), cloud.size(),
+                fusion_s, seconds_since(start) - fusion_s);
+    return 0;
+  }
+#endif
   if (!cloud_file.empty()) {
     const mvs::OrientedPointCloud cloud = mvs::read_point_cloud_ply(cloud_file);
     const auto start = Clock::now();
