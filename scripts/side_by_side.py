@@ -2,8 +2,9 @@
 """The image work of scripts/side-by-side, with the standard library only
 (PNG read and write through zlib), so that it runs wherever tega does.
 
-    side_by_side.py pick CAPTURE CAMERA_OR_EMPTY FRAMES_TXT
-        prints "CAMERA WRINKLE_FRAME BLINK_FRAME" and writes why to FRAMES_TXT
+    side_by_side.py pick DATASET TRUTH CAMERA_OR_EMPTY FRAMES_TXT
+        prints "CAMERA WRINKLE_FRAME BLINK_FRAME" (DATASET's held-out frames, ranked by
+        TRUTH's ground truth) and writes why to FRAMES_TXT
     side_by_side.py compose DATASET CAMERA FRAME OUT ROW...
         writes OUT/FRAME-{full,eyes,mouth}.png: truth | each row's render
 """
@@ -114,13 +115,13 @@ def part_box(points, width, height):
     return x0, y0, x1, y1
 
 
-def pick(capture, camera, frames_txt):
-    dataset = json.load(open(os.path.join(capture, "dataset", "dataset.json")))
+def pick(dataset_dir, truth, camera, frames_txt):
+    dataset = json.load(open(os.path.join(dataset_dir, "dataset.json")))
     test_frames = set(dataset["split"]["test"]["frames"])
     camera = camera or dataset["split"]["train"]["cameras"][0]
     wrinkle, blink = (None, -1.0), (None, -1.0)
     for take in sorted({f.rsplit("_", 1)[0] for f in test_frames}):
-        frames = json.load(open(os.path.join(capture, "ground_truth", take, "frames.json")))["frames"]
+        frames = json.load(open(os.path.join(truth, "ground_truth", take, "frames.json")))["frames"]
         for f in frames:
             frame_id = f"{take}_{f['index']:06d}"
             if frame_id not in test_frames:
@@ -132,7 +133,7 @@ def pick(capture, camera, frames_txt):
             if blinked > blink[1] and frame_id != wrinkle[0]:
                 blink = (frame_id, blinked)
     if wrinkle[0] is None or blink[0] is None:
-        sys.exit(f"side-by-side: {capture}: the test take has fewer than two frames")
+        sys.exit(f"side-by-side: {dataset_dir}: the test take has fewer than two frames")
     with open(frames_txt, "w") as f:
         f.write(f"camera {camera}\nwrinkle frame {wrinkle[0]} (wrinkle activations summing to {wrinkle[1]:.2f})\n"
                 f"blink frame {blink[0]} (eyeBlink_L + eyeBlink_R = {blink[1]:.2f})\n")
@@ -162,8 +163,8 @@ def compose(dataset_dir, camera_name, frame, out, rows):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) == 5 and sys.argv[1] == "pick":
-        pick(sys.argv[2], sys.argv[3], sys.argv[4])
+    if len(sys.argv) == 6 and sys.argv[1] == "pick":
+        pick(sys.argv[2], sys.argv[3], sys.argv[4], sys.argv[5])
     elif len(sys.argv) >= 6 and sys.argv[1] == "compose":
         compose(sys.argv[2], sys.argv[3], sys.argv[4], sys.argv[5], sys.argv[6:])
     else:

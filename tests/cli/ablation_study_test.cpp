@@ -13,6 +13,7 @@
 
 #include "cli_support.h"
 #include "tega/core/files.h"
+#include "tega/core/image.h"
 #include "test_support.h"
 
 namespace tega::test {
@@ -113,6 +114,36 @@ TEST(AblationStudy, TrainsOnAGivenDatasetAndInspectsAgainstAGivenTruth) {
   EXPECT_NE(read_text_file(tmp / "study/runs/full.s0/run.json").find((tmp / "elsewhere/dataset").string()),
             std::string::npos);
   EXPECT_NE(read_text_file(tmp / "study/liveness.md").find("## full.s0"), std::string::npos);
+
+  // A row added to the finished study is trained, tabulated and inspected with the first.
+  const auto grown = run_command(given + "VARIANTS='full gaussian-avatars' TRUTH=" + (tmp / "elsewhere").string() +
+                                 " bash " + kScript + " " + (tmp / "study").string());
+  ASSERT_EQ(grown.exit_code, 0) << grown.output;
+  const std::string liveness = read_text_file(tmp / "study/liveness.md");
+  EXPECT_NE(liveness.find("## full.s0"), std::string::npos) << liveness;
+  EXPECT_NE(liveness.find("## gaussian-avatars.s0"), std::string::npos) << liveness;
+  EXPECT_EQ(nlohmann::json::parse(read_text_file(tmp / "study/liveness.json")).size(), 2u);
+
+  // The paper's Figs. 6-7 from that study: the given dataset's photo beside each row's render.
+  const auto figures = run_command("TEGA=" + std::string(TEGA_EXECUTABLE) + " ROWS='full gaussian-avatars' DATASET=" +
+                                   (tmp / "elsewhere/dataset").string() + " TRUTH=" + (tmp / "elsewhere").string() +
+                                   " bash " + std::string(TEGA_SOURCE_DIR) + "/scripts/side-by-side " +
+                                   (tmp / "study").string() + " " + (tmp / "figures").string());
+  ASSERT_EQ(figures.exit_code, 0) << figures.output;
+  const std::string picked = read_text_file(tmp / "figures/frames.txt");
+  const std::size_t wrinkle = picked.find("wrinkle frame freestyle_");
+  ASSERT_NE(wrinkle, std::string::npos) << picked;  // the capture's held-out take
+  const std::string frame = picked.substr(wrinkle + 14, picked.find(' ', wrinkle + 14) - wrinkle - 14);
+  const Image8 strip = read_image_u8(tmp / "figures" / (frame + "-full.png"));
+  EXPECT_EQ(strip.width, 3 * 96 + 2 * 4);  // photo | full | gaussian-avatars, 4 px apart
+  EXPECT_EQ(strip.height, 64);
+
+  const auto no_truth = run_command("TEGA=" + std::string(TEGA_EXECUTABLE) + " DATASET=" +
+                                    (tmp / "elsewhere/dataset").string() + " bash " + std::string(TEGA_SOURCE_DIR) +
+                                    "/scripts/side-by-side " + (tmp / "study").string() + " " +
+                                    (tmp / "figures2").string());
+  EXPECT_EQ(no_truth.exit_code, 1) << no_truth.output;
+  EXPECT_NE(no_truth.output.find("set TRUTH to the study's"), std::string::npos) << no_truth.output;
 
   const auto unscored = run_command(given + "bash " + kScript + " " + (tmp / "unscored").string());
   ASSERT_EQ(unscored.exit_code, 0) << unscored.output;
