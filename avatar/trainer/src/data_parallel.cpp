@@ -169,4 +169,8 @@ void DataParallel::barrier() { host_sum({0.0}); }
 
 double learning_rate_factor(int views_per_step) { return std::sqrt(static_cast<double>(std::max(1, views_per_step))); }
 
+double moment_decay(double beta, int views_per_step) {
+  return std::pow(beta, static_cast<double>(std::max(1, views_per_step)));
+}
+
 }  // namespace tega::trainer

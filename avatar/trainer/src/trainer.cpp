@@ -509,7 +509,8 @@ class Run {
   }
 
   void register_parameters() {
-    adam_ = Adam();
+    const int views_a_step = options_.momentum_per_view ? parallel_.world() : 1;
+    adam_ = Adam(moment_decay(Adam::kBeta1, views_a_step), moment_decay(Adam::kBeta2, views_a_step));
     const auto& lr = options_.learning_rates;
     auto& g = model_.gaussians;
     // Position learning rates are in metres: uv, d and rigged local units convert.

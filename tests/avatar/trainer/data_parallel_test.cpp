@@ -66,5 +66,13 @@ TEST(DataParallel, LearningRatesGrowWithTheSquareRootOfTheViewsAStep) {
   EXPECT_DOUBLE_EQ(learning_rate_factor(2), std::sqrt(2.0));
 }
 
+TEST(DataParallel, MomentDecaysKeepTheirRatePerView) {
+  EXPECT_DOUBLE_EQ(moment_decay(0.9, 1), 0.9);
+  EXPECT_NEAR(moment_decay(0.9, 2), 0.81, 1e-15);
+  EXPECT_NEAR(moment_decay(0.999, 4), 0.999 * 0.999 * 0.999 * 0.999, 1e-15);
+  // What a moment keeps of a view after 40 views, one a step or four a step: the same.
+  EXPECT_NEAR(std::pow(moment_decay(0.9, 4), 10), std::pow(0.9, 40), 1e-15);
+}
+
 }  // namespace
 }  // namespace tega::trainer

@@ -1,5 +1,6 @@
 // Training shared by two processes (data_parallel.h) on the CPU: a NaN in one process's step rolls
-// both back, as on one GPU. The test runs its own executable twice as the two processes.
+// both back, as on one GPU; momentum_per_view sets Adam's decays for two views a step. The test
+// runs its own executable twice as the two processes.
 
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -11,6 +12,7 @@
 #include <cstdlib>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "tega/trainer/checkpoint.h"
@@ -31,14 +33,19 @@ constexpr const char* kPhaseVariable = "TEGA_TEST_TRAINING_PHASE";
 // One of the two processes of a phase, in FOLDER: "rolled" trains FOLDER/rolled with the second
 // process's loss of iteration 5 made NaN; "reference-start" trains FOLDER/reference to iteration 3
 // and "reference-rest" resumes it with every learning rate halved, what a roll-back from 5 to
-// the checkpoint of 3 does.
+// the checkpoint of 3 does; "per-view" and "per-step" take one step into FOLDER/<phase>, with
+// and without momentum_per_view.
 void train_as_one_of_two(int rank, const std::filesystem::path& folder, const std::string& phase) {
   TrainOptions options = test::tiny_options();
   options.checkpoint_every = 3;
   RunControl control;
   control.parallel = {rank, 2, folder / (phase + ".rendezvous")};
   std::filesystem::path run = folder / "reference";
-  if (phase == "rolled") {
+  if (phase == "per-view" || phase == "per-step") {
+    run = folder / phase;
+    options.momentum_per_view = phase == "per-view";
+    control.stop_at = 1;
+  } else if (phase == "rolled") {
     run = folder / "rolled";
     if (rank == 1) control.poisoned_iterations = {5};
   } else if (phase == "reference-start") {
@@ -115,6 +122,32 @@ TEST(DataParallelTraining, ANanInOneProcessRollsEveryProcessBack) {
   ASSERT_TRUE(train_two_processes(tmp.path(), "reference-start"));
   ASSERT_TRUE(train_two_processes(tmp.path(), "reference-rest"));
   test::expect_same_parameters(tmp / "reference", tmp / "rolled");
+}
+
+// The first step's moments hold (1 - β1) g and (1 - β2) g² of each gradient g, so m² / v is
+// (1 - β1)² / (1 - β2) wherever g is not zero: 10 with Adam's decays a step, and with
+// momentum_per_view on two processes (β1², β2²) 0.19² / (1 - 0.999²).
+TEST(DataParallelTraining, MomentumPerViewSquaresTheDecaysOnTwoProcesses) {
+  if (!DataParallel::available(at::kCPU)) GTEST_SKIP() << "this build's libtorch has no c10d with Gloo";
+  if (const char* rank = std::getenv(kRankVariable)) {
+    train_as_one_of_two(std::atoi(rank), std::getenv(kFolderVariable), std::getenv(kPhaseVariable));
+    return;
+  }
+  test::TempDir tmp;
+  test::write_tiny_dataset(tmp / "data", /*eyeball=*/false);
+  for (const auto& [phase, ratio] : {std::pair<std::string, double>{"per-step", 0.1 * 0.1 / 0.001},
+                                     {"per-view", 0.19 * 0.19 / (1 - 0.999 * 0.999)}}) {
+    ASSERT_TRUE(train_two_processes(tmp.path(), phase));
+    const Checkpoint first = read_checkpoint(tmp / phase / "checkpoint.safetensors");
+    ASSERT_EQ(first.iteration(), 1);
+    const at::Tensor m = first.tensors.at("sh_dc.adam_m").to(at::kDouble);
+    const at::Tensor v = first.tensors.at("sh_dc.adam_v").to(at::kDouble);
+    const at::Tensor moved = v > 1e-20;
+    ASSERT_GT(moved.sum().item<int64_t>(), 0) << phase;
+    const at::Tensor ratios = m.pow(2).masked_select(moved) / v.masked_select(moved);
+    EXPECT_NEAR(ratios.min().item<double>(), ratio, 1e-3 * ratio) << phase;
+    EXPECT_NEAR(ratios.max().item<double>(), ratio, 1e-3 * ratio) << phase;
+  }
 }
 
 }  // namespace

@@ -26,7 +26,9 @@ class Adam {
     at::Tensor first_moment, second_moment;  // same shape as parameter
   };
 
-  explicit Adam(double beta1 = 0.9, double beta2 = 0.999, double epsilon = 1e-15);
+  static constexpr double kBeta1 = 0.9, kBeta2 = 0.999;  // the moments' decay a step, as 3DGS
+
+  explicit Adam(double beta1 = kBeta1, double beta2 = kBeta2, double epsilon = 1e-15);
 
   void add(const std::string& name, const at::Tensor& parameter, double learning_rate,
            const at::Tensor& step_scale = at::Tensor());

@@ -54,5 +54,9 @@ class DataParallel {
 // Learning rates for `views_per_step` views a step (one per process) instead of one: scaled by
 // its square root, as Grendel (Zhao et al. 2024) does for 3DGS trained on larger batches.
 double learning_rate_factor(int views_per_step);
+// Adam's decay `beta` a step for `views_per_step` views a step: beta^views_per_step, so that the
+// moments forget at the same rate per view seen as with one view a step (Grendel's momentum rule,
+// beside its √batch learning rates).
+double moment_decay(double beta, int views_per_step);
 
 }  // namespace tega::trainer

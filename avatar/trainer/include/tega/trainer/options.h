@@ -118,6 +118,7 @@ struct TrainOptions {
   bool antialiased = false;
   int64_t checkpoint_every = 5000;
   double rollback_learning_rate_factor = 0.5;  // after a NaN/Inf step or a runaway field
+  bool momentum_per_view = false;                // on N GPUs: Adam's decays ^N (Grendel)
   double max_deformation = 0.05;                 // metres; 0 = unbounded
   int64_t log_every = 10;
   int loader_threads = 4;
@@ -154,6 +155,10 @@ struct TrainOptions {
       "A step whose loss or gradients hold NaN/Inf, or whose deformation field runs away (max_deformation), rolls "
       "training back to its last checkpoint, once, and every learning rate is multiplied by this from there on; a "
       "second such step stops training.");
+    v("momentum_per_view", momentum_per_view,
+      "On several GPUs (N views a step): raise Adam's moment decays (0.9, 0.999) to the N-th power, so that the "
+      "moments forget at the same rate per view as on one GPU, as Grendel does beside its sqrt(N) learning rates. "
+      "false: one GPU's decays a step. No effect on one GPU.");
     v("max_deformation", max_deformation,
       "Metres: a step whose deformation field moves a Gaussian further than this has diverged, as a NaN/Inf step has "
       "(a field that runs away stays finite while it renders the head away). 0: no bound.");
