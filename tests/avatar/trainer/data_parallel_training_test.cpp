@@ -59,6 +59,14 @@ void train_as_one_of_two(int rank, const std::filesystem::path& folder, const st
   EXPECT_EQ(summary.iterations, control.stop_at ? control.stop_at : 6);
 }
 
+// In a process that start_process started: trains its part and says so.
+bool trained_as_one_of_two() {
+  const char* rank = std::getenv(kRankVariable);
+  if (!rank) return false;
+  train_as_one_of_two(std::atoi(rank), std::getenv(kFolderVariable), std::getenv(kPhaseVariable));
+  return true;
+}
+
 // Starts this test in another process, as `rank` of `phase`'s two.
 pid_t start_process(int rank, const std::filesystem::path& folder, const std::string& phase) {
   std::vector<std::string> environment{std::string(kRankVariable) + "=" + std::to_string(rank),
@@ -108,10 +116,7 @@ bool train_two_processes(const std::filesystem::path& folder, const std::string&
 // resumed with halved learning rates end (and, compared at the end, agree with each other).
 TEST(DataParallelTraining, ANanInOneProcessRollsEveryProcessBack) {
   if (!DataParallel::available(at::kCPU)) GTEST_SKIP() << "this build's libtorch has no c10d with Gloo";
-  if (const char* rank = std::getenv(kRankVariable)) {
-    train_as_one_of_two(std::atoi(rank), std::getenv(kFolderVariable), std::getenv(kPhaseVariable));
-    return;
-  }
+  if (trained_as_one_of_two()) return;
   test::TempDir tmp;
   test::write_tiny_dataset(tmp / "data", /*eyeball=*/false);
   ASSERT_TRUE(train_two_processes(tmp.path(), "rolled"));
@@ -129,10 +134,7 @@ TEST(DataParallelTraining, ANanInOneProcessRollsEveryProcessBack) {
 // momentum_per_view on two processes (β1², β2²) 0.19² / (1 - 0.999²).
 TEST(DataParallelTraining, MomentumPerViewSquaresTheDecaysOnTwoProcesses) {
   if (!DataParallel::available(at::kCPU)) GTEST_SKIP() << "this build's libtorch has no c10d with Gloo";
-  if (const char* rank = std::getenv(kRankVariable)) {
-    train_as_one_of_two(std::atoi(rank), std::getenv(kFolderVariable), std::getenv(kPhaseVariable));
-    return;
-  }
+  if (trained_as_one_of_two()) return;
   test::TempDir tmp;
   test::write_tiny_dataset(tmp / "data", /*eyeball=*/false);
   for (const auto& [phase, ratio] : {std::pair<std::string, double>{"per-step", 0.1 * 0.1 / 0.001},
