@@ -124,6 +124,14 @@ TEST(AblationStudy, TrainsOnAGivenDatasetAndInspectsAgainstAGivenTruth) {
   EXPECT_NE(liveness.find("## gaussian-avatars.s0"), std::string::npos) << liveness;
   EXPECT_EQ(nlohmann::json::parse(read_text_file(tmp / "study/liveness.json")).size(), 2u);
 
+  // Trained on to more iterations, its runs are inspected again there.
+  const auto longer = run_command(given + "VARIANTS='full gaussian-avatars' ITERATIONS=16 TRUTH=" +
+                                  (tmp / "elsewhere").string() + " bash " + kScript + " " + (tmp / "study").string());
+  ASSERT_EQ(longer.exit_code, 0) << longer.output;
+  const std::string relived = read_text_file(tmp / "study/liveness.md");
+  EXPECT_NE(relived.find("## full.s0 (iteration 16,"), std::string::npos) << relived;
+  EXPECT_NE(relived.find("## gaussian-avatars.s0 (iteration 16,"), std::string::npos) << relived;
+
   // The paper's Figs. 6-7 from that study: the given dataset's photo beside each row's render.
   const auto figures = run_command("TEGA=" + std::string(TEGA_EXECUTABLE) + " ROWS='full gaussian-avatars' DATASET=" +
                                    (tmp / "elsewhere/dataset").string() + " TRUTH=" + (tmp / "elsewhere").string() +
