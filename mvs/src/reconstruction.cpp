@@ -302,14 +302,15 @@ void reconstruct_frames(const TakeJob& job, const Options& options, MvsSummary& 
 }
 
 // The defaults' matching windows are sized for 512 x 384: at a studio's 3072 x 2048 they span a
-// sixth of the face they are meant to (docs/mvs.md#options), which nothing else would tell.
+// sixth of the face they are meant to (docs/mvs.md#options), which nothing else would tell. A third
+// is what the studio's settings span, the narrowest measured to gain.
 void warn_of_small_windows(const Rig& rig, const PatchMatchOptions& patch_match) {
   int widest = 0;
   for (const Camera& camera : rig.cameras) widest = std::max(widest, camera.width);
-  if (widest <= 256 * patch_match.window_radius) return;
+  if (widest <= 384 * patch_match.window_radius) return;
   logging::warn("mvs: the cameras are %d pixels wide and patch_match.window_radius is %d: the windows cover under "
-                "half as much of the face as the defaults' at 512 x 384; scale window_radius and window_step with "
-                "the image (12 and 6 at 3072 x 2048, as studio_configs/studio13-capture.yaml sets them; "
+                "a third as much of the face as the defaults' at 512 x 384; scale window_radius and window_step "
+                "with the image (8 and 4 at 3072 x 2048, as studio_configs/studio13-capture.yaml sets them; "
                 "docs/mvs.md#options)",
                 widest, patch_match.window_radius);
 }

@@ -82,12 +82,12 @@ TEST(Mvs, WarnsWhenTheWindowsAreSmallForTheImages) {
   MvsRequest request{studio_capture(), {}, dir / "meshes", {}, 5, 6};  // no frame 5: it stops after the check
   init_logging(1);  // to stderr, as the tega command logs
   Options sized = cpu_options();
-  sized.patch_match.window_radius = 2;  // 512 wide: as 4 at 1024, fine
+  sized.patch_match.window_radius = 2;  // 512 wide: as 12 at 3072, fine
   testing::internal::CaptureStderr();
   EXPECT_THROW(reconstruct_capture(request, sized), Error);
   EXPECT_EQ(testing::internal::GetCapturedStderr().find("window_radius"), std::string::npos);
   Options small = cpu_options();
-  small.patch_match.window_radius = 1;  // as 4 at 2048
+  small.patch_match.window_radius = 1;  // as 4 at 2048, or 6 at 3072
   testing::internal::CaptureStderr();
   EXPECT_THROW(reconstruct_capture(request, small), Error);
   const std::string log = testing::internal::GetCapturedStderr();
