@@ -113,7 +113,8 @@ int main(int argc, char** argv) {
     options.iterations += iterations;
     const auto unprofiled = tega::trainer::train(data, run, options, {.resume = true});
     std::printf("unprofiled: %.2f ms / iteration over %lld iterations (wall clock, after the first)\n",
-                1e3 * unprofiled.steady_seconds / double(iterations - 1), static_cast<long long>(iterations - 1));
+                1e3 * unprofiled.steady_seconds / double(unprofiled.steady_iterations),
+                static_cast<long long>(unprofiled.steady_iterations));
     if (!trace.empty()) {
       options.iterations += 3;
       trace_to(trace, [&] { tega::trainer::train(data, run, options, {.resume = true}); });

@@ -234,8 +234,11 @@ class Run {
       if (checkpoint_due) save();
     }
     profiler_.stop();
-    summary.steady_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - first_done).count();
+    const auto loop_done = std::chrono::steady_clock::now();
+    summary.steady_iterations = std::max<int64_t>(iteration_ - first - 1, 0);
+    summary.steady_seconds = std::chrono::duration<double>(loop_done - first_done).count();
     save();
+    summary.checkpoint_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - loop_done).count();
     summary.iterations = iteration_;
     summary.gaussians = model_.gaussians.size();
     summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -678,6 +681,9 @@ TrainSummary train(const fs::path& dataset, const fs::path& run, TrainOptions op
                                  {"train_psnr", summary.train_psnr},
                                  {"heldout_psnr", summary.heldout_psnr},
                                  {"seconds", summary.seconds},
+                                 {"steady_iterations", summary.steady_iterations},
+                                 {"steady_seconds", summary.steady_seconds},
+                                 {"checkpoint_seconds", summary.checkpoint_seconds},
                                  {"interrupted", summary.interrupted},
                                  {"checkpoint", kCheckpoint}};
   write_text_atomic(run / "run.json", report.dump(2));

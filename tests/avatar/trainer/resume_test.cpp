@@ -88,6 +88,12 @@ TEST(Trainer, ASignalStopsTheRunWithACheckpointThatResumesExactly) {
   EXPECT_FALSE(rest.interrupted);
   EXPECT_EQ(rest.iterations, 24);
   expect_same_parameters(tmp / "straight", tmp / "sliced");
+  // Its times are the resumed invocation's: the steady steps are its own after its first.
+  const auto resumed = nlohmann::json::parse(tega::read_text_file(tmp / "sliced/run.json"));
+  EXPECT_EQ(resumed.at("steady_iterations").get<int64_t>(), 24 - first.iterations - 1);
+  EXPECT_GT(resumed.at("checkpoint_seconds").get<double>(), 0.0);
+  EXPECT_LE(resumed.at("steady_seconds").get<double>() + resumed.at("checkpoint_seconds").get<double>(),
+            resumed.at("seconds").get<double>());
 }
 
 // A latest checkpoint cut short (a copy interrupted, a disk error): the

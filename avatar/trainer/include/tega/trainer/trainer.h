@@ -28,7 +28,9 @@ struct TrainSummary {
   double seconds = 0;           // this invocation's training time
   // The iterations after this invocation's first (which waits for the loader's
   // first image), without the final checkpoint and evaluation.
+  int64_t steady_iterations = 0;
   double steady_seconds = 0;
+  double checkpoint_seconds = 0;  // the final checkpoint's writing, which a longer run repeats
   double final_loss = 0;
   double train_psnr = 0;        // mean over the last logged window
   double heldout_psnr = 0;      // train frames seen from the test cameras (novel view)
