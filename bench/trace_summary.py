@@ -91,7 +91,7 @@ def main():
             continue
         part = part_of(op)
         per_part[part] += k["dur"]
-        per_kernel[(part, k["name"][:90])] += k["dur"]
+        per_kernel[(part, op["name"], k["name"][:80])] += k["dur"]
         step_kernels.append((k["ts"], k["ts"] + k["dur"], part, k["name"]))
 
     n = len(steps) or 1
@@ -102,9 +102,9 @@ def main():
         print(f"| {part} | {us / 1000 / n:.2f} | {100 * us / total:.1f}% |")
     print_idle(step_kernels, n)
     print_host_lead(steps, step_kernels)
-    print(f"\nTop {args.top} kernels:\n| part | kernel | ms / iteration |\n|---|---|---:|")
-    for (part, name), us in per_kernel.most_common(args.top):
-        print(f"| {part} | `{name}` | {us / 1000 / n:.2f} |")
+    print(f"\nTop {args.top} kernels:\n| part | launched by | kernel | ms / iteration |\n|---|---|---|---:|")
+    for (part, op_name, name), us in per_kernel.most_common(args.top):
+        print(f"| {part} | `{op_name}` | `{name}` | {us / 1000 / n:.2f} |")
 
 
 def print_idle(step_kernels, steps, shown=8):

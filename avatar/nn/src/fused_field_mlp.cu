@@ -44,6 +44,7 @@ constexpr int kHiddenSteps = kHidden / 16;    // 16-wide k steps over a hidden l
 constexpr int kHiddenStride = kHidden + 8;    // shared rows padded so fragment loads hit distinct banks
 constexpr int kNarrowStride = 16 + 8;         // the same for 16-wide rows
 constexpr int kOutputRows = 16;               // the output layer padded to one k step
+constexpr int kAccumulatorFloats = kHiddenBlocks * 4 * 32;  // a warp's hidden-width C tiles
 
 using Bits = uint16_t;  // one bfloat16
 
@@ -63,7 +64,7 @@ struct Layout {
   int first_stride;          // row stride of the first layer's weight and of its staged inputs
   bool tangents;
   size_t w0, wa, w1, w2, b0, b1, b2;
-  size_t scratch;  // the backward kernel's per-warp accumulator of the first layer's gradient; the forward's end
+  size_t scratch;  // the backward kernel's per-warp accumulators (the forward's end)
   size_t end;
 };
 
@@ -86,7 +87,7 @@ Layout layout_of(const Shape& s) {
   l.b0 = take(sizeof(float) * kHidden);
   l.b1 = take(sizeof(float) * kHidden);
   l.b2 = take(sizeof(float) * kOutputRows);
-  l.scratch = take(sizeof(float) * kWarps * kHiddenBlocks * 4 * 32);
+  l.scratch = take(l.tangents ? sizeof(float) * kWarps * kAccumulatorFloats * 2 : 0);
   l.end = at;
   return l;
 }
@@ -364,8 +365,12 @@ __device__ __forceinline__ void for_tile(const C& c, int64_t r0, int column0, La
 
 // --- forward -----------------------------------------------------------------
 
-__global__ void __launch_bounds__(kThreads) fused_field_forward(Shape s, Layout lay, Weights w, Inputs in,
-                                                                float* __restrict__ value, float* __restrict__ jacobian) {
+// Compiled apart with and without the tangents, so that a field without them
+// (shading) gets registers for its own path: more warps a multiprocessor.
+template <bool Tangents>
+__global__ void __launch_bounds__(kThreads, Tangents ? 3 : 4)
+    fused_field_forward(Shape s, Layout lay, Weights w, Inputs in, float* __restrict__ value,
+                        float* __restrict__ jacobian) {
   extern __shared__ uint4 shared_memory[];
   const Shared sh = shared_weights(reinterpret_cast<char*>(shared_memory), lay);
   load_weights(s, lay, w, sh);
@@ -392,20 +397,21 @@ __global__ void __launch_bounds__(kThreads) fused_field_forward(Shape s, Layout 
     A h1[kHiddenSteps];
     for (int kb = 0; kb < kHiddenSteps; ++kb) h1[kb] = to_a(z, kb, [](float x, int, int) { return silu(x); });
     write_outputs(output_layer(h1, sh, sh.b2, l), r0, value, 1, 0);
-    if (!lay.tangents) continue;
-    C d1[kHiddenBlocks];  // silu'(z1)
-    for (int nb = 0; nb < kHiddenBlocks; ++nb)
-      for (int i = 0; i < 4; ++i) d1[nb].v[i] = silu_d1(z[nb].v[i]);
-    for (int axis = 0; axis < kAxes; ++axis) {
-      C t[kHiddenBlocks];
-      first_tangent(t, s, sh, in, axis, r0, l);
-      A u[kHiddenSteps];
-      for (int kb = 0; kb < kHiddenSteps; ++kb)
-        u[kb] = to_a(t, kb, [&](float x, int nb, int i) { return d0[nb].v[i] * x; });
-      hidden_layer(t, u, sh, nullptr, l);
-      for (int kb = 0; kb < kHiddenSteps; ++kb)
-        u[kb] = to_a(t, kb, [&](float x, int nb, int i) { return d1[nb].v[i] * x; });
-      write_outputs(output_layer(u, sh, nullptr, l), r0, jacobian, kAxes, axis);
+    if constexpr (Tangents) {
+      C d1[kHiddenBlocks];  // silu'(z1)
+      for (int nb = 0; nb < kHiddenBlocks; ++nb)
+        for (int i = 0; i < 4; ++i) d1[nb].v[i] = silu_d1(z[nb].v[i]);
+      for (int axis = 0; axis < kAxes; ++axis) {
+        C t[kHiddenBlocks];
+        first_tangent(t, s, sh, in, axis, r0, l);
+        A u[kHiddenSteps];
+        for (int kb = 0; kb < kHiddenSteps; ++kb)
+          u[kb] = to_a(t, kb, [&](float x, int nb, int i) { return d0[nb].v[i] * x; });
+        hidden_layer(t, u, sh, nullptr, l);
+        for (int kb = 0; kb < kHiddenSteps; ++kb)
+          u[kb] = to_a(t, kb, [&](float x, int nb, int i) { return d1[nb].v[i] * x; });
+        write_outputs(output_layer(u, sh, nullptr, l), r0, jacobian, kAxes, axis);
+      }
     }
   }
 }
@@ -465,11 +471,33 @@ __device__ __forceinline__ void input_tiles(C (&c)[2], const A (&g)[kHiddenSteps
   }
 }
 
+// Hides a's values from the compiler for what follows, so that values computed
+// from them before (SiLU's derivatives: two special-function operations each)
+// are not kept in registers to be reused after, nor hoisted out of a loop.
+__device__ __forceinline__ void opaque(A (&a)[kHiddenSteps]) {
+#pragma unroll
+  for (int kb = 0; kb < kHiddenSteps; ++kb)
+#pragma unroll
+    for (int j = 0; j < 4; ++j) asm volatile("" : "+r"(a[kb].r[j]));
+}
+
+// A warp's hidden-width C tiles held in shared memory (element i of tile nb of
+// lane j at [nb * 4 + i][j], so that a warp's access hits 32 banks), where
+// registers would spill.
+struct SharedTiles {
+  float* lane;  // this lane's element 0
+  __device__ __forceinline__ float& operator()(int nb, int i) const { return lane[(nb * 4 + i) * 32]; }
+};
+
 // Each warp takes 16 points: the forward again, then the output gradients
 // back to the inputs. What the weight gradients need (each layer's inputs and
 // its pre-activations' gradients) is written out in bfloat16 for the matrix
-// products that sum them over the points (fused_field_mlp.cpp).
-__global__ void __launch_bounds__(kThreads)
+// products that sum them over the points (fused_field_mlp.cpp). Compiled apart
+// with and without the tangents, as the forward is. With them it takes 255
+// registers (two blocks a multiprocessor) and spills 16 bytes: capped at 168
+// for three blocks it spilled ~500 and a training step took longer (H200).
+template <bool Tangents>
+__global__ void __launch_bounds__(kThreads, Tangents ? 2 : 4)
     fused_field_backward(Shape s, Layout lay, Weights w, Inputs in, const float* __restrict__ grad_value,
                          const float* __restrict__ grad_jacobian, __nv_bfloat16* __restrict__ grad_encoding,
                          __nv_bfloat16* __restrict__ grad_derivatives, float* __restrict__ grad_condition, Products p) {
@@ -481,10 +509,11 @@ __global__ void __launch_bounds__(kThreads)
   const int64_t n = s.points, chunks = (n + kWarpRows - 1) / kWarpRows;
   const auto set = [&](__nv_bfloat16* m, int index, int width) { return m + int64_t(index) * n * width; };
   const auto identity = [](float x, int, int) { return x; };
-  // The first layer's pre-activation gradient builds up over the axes in
-  // shared memory (element k of lane j at [k][j]), to leave registers free.
-  float* const gz0 = reinterpret_cast<float*>(reinterpret_cast<char*>(shared_memory) + lay.scratch) +
-                     warp * kHiddenBlocks * 4 * 32 + threadIdx.x % 32;
+  // With the tangents, the pre-activation gradients of both layers build up
+  // over the axes in shared memory, to leave registers for one axis's work.
+  float* const scratch = reinterpret_cast<float*>(reinterpret_cast<char*>(shared_memory) + lay.scratch) +
+                         warp * 2 * kAccumulatorFloats + threadIdx.x % 32;
+  const SharedTiles gz0_sum{scratch}, gz1_sum{scratch + kAccumulatorFloats};
 
   for (int64_t chunk = int64_t(blockIdx.x) * kWarps + warp; chunk < chunks; chunk += int64_t(gridDim.x) * kWarps) {
     const int64_t r0 = chunk * kWarpRows;
@@ -506,16 +535,32 @@ __global__ void __launch_bounds__(kThreads)
 #pragma unroll
     for (int nb = 0; nb < kHiddenBlocks; ++nb)
 #pragma unroll
-      for (int i = 0; i < 4; ++i) {
-        gz1[nb].v[i] *= silu_d1(element(z1, nb, i));
-        gz0[(nb * 4 + i) * 32] = 0.0f;
-      }
-    if (lay.tangents) {
+      for (int i = 0; i < 4; ++i) gz1[nb].v[i] *= silu_d1(element(z1, nb, i));
+    if constexpr (Tangents) {
+#pragma unroll
+      for (int nb = 0; nb < kHiddenBlocks; ++nb)
+#pragma unroll
+        for (int i = 0; i < 4; ++i) {
+          gz1_sum(nb, i) = gz1[nb].v[i];
+          gz0_sum(nb, i) = 0.0f;
+        }
+      // silu'(z0), packed once for the three axes: computed where it is used,
+      // its special functions made the kernel spill.
+      A d1z0[kHiddenSteps];
+#pragma unroll
+      for (int kb = 0; kb < kHiddenSteps; ++kb)
+#pragma unroll
+        for (int j = 0; j < 4; ++j) {
+          const int nb = 2 * kb + j / 2, i = (j % 2) * 2;  // the elements of register j (to_a's order)
+          d1z0[kb].r[j] = pack(silu_d1(element(z0, nb, i)), silu_d1(element(z0, nb, i + 1)));
+        }
 #pragma unroll 1  // one axis at a time: unrolled, the axes' registers overlap and spill
       for (int axis = 0; axis < kAxes; ++axis) {
         C t[kHiddenBlocks], g[kHiddenBlocks];
+        opaque(z0);  // SiLU's derivatives kept across the axes made the kernel spill
+        opaque(z1);
         first_tangent(t, s, sh, in, axis, r0, l);
-        pack_tiles(frag, t, [&](float x, int nb, int i) { return silu_d1(element(z0, nb, i)) * x; });
+        pack_tiles(frag, t, [&](float x, int nb, int i) { return element(d1z0, nb, i) * x; });
         store_tiles(set(p.hidden_inputs, 1 + axis, kHidden), n, r0, frag, l);
         hidden_layer(t, frag, sh, nullptr, l);  // t: the hidden layer's tangent from here on
         const A gj = gradient_a(grad_jacobian, n, s.outputs, kAxes, axis, r0, l);
@@ -526,7 +571,7 @@ __global__ void __launch_bounds__(kThreads)
 #pragma unroll
           for (int i = 0; i < 4; ++i) {
             const SiluDerivatives d = silu_derivatives(element(z1, nb, i));
-            gz1[nb].v[i] += g[nb].v[i] * t[nb].v[i] * d.d2;
+            gz1_sum(nb, i) += g[nb].v[i] * t[nb].v[i] * d.d2;
             g[nb].v[i] *= d.d1;
             t[nb].v[i] *= d.d1;  // t: the output layer's input along this axis from here on
           }
@@ -541,7 +586,7 @@ __global__ void __launch_bounds__(kThreads)
 #pragma unroll
           for (int i = 0; i < 4; ++i) {
             const SiluDerivatives d = silu_derivatives(element(z0, nb, i));
-            gz0[(nb * 4 + i) * 32] += g[nb].v[i] * t[nb].v[i] * d.d2;
+            gz0_sum(nb, i) += g[nb].v[i] * t[nb].v[i] * d.d2;
             g[nb].v[i] *= d.d1;
           }
         pack_tiles(frag, g, identity);
@@ -558,6 +603,10 @@ __global__ void __launch_bounds__(kThreads)
               *reinterpret_cast<__nv_bfloat162*>(gd + r * s.derivative_width + f) = __floats2bfloat162_rn(lo, hi);
           });
       }
+#pragma unroll
+      for (int nb = 0; nb < kHiddenBlocks; ++nb)
+#pragma unroll
+        for (int i = 0; i < 4; ++i) gz1[nb].v[i] = gz1_sum(nb, i);
     }
     pack_tiles(frag, gz1, identity);
     store_tiles(p.hidden_gradients, n, r0, frag, l);
@@ -565,7 +614,8 @@ __global__ void __launch_bounds__(kThreads)
 #pragma unroll
     for (int nb = 0; nb < kHiddenBlocks; ++nb)
 #pragma unroll
-      for (int i = 0; i < 4; ++i) acc[nb].v[i] = gz0[(nb * 4 + i) * 32] + gz1[nb].v[i] * silu_d1(element(z0, nb, i));
+      for (int i = 0; i < 4; ++i)
+        acc[nb].v[i] = (Tangents ? gz0_sum(nb, i) : 0.0f) + gz1[nb].v[i] * silu_d1(element(z0, nb, i));
     pack_tiles(frag, acc, identity);
     store_tiles(p.first_gradients, n, r0, frag, l);
     // The encoding's and condition's gradients: frag · W0.
@@ -607,10 +657,11 @@ void forward(const Shape& shape, const Weights& weights, const Inputs& inputs, f
              int multiprocessors, cudaStream_t stream) {
   if (shape.points == 0) return;
   const Layout lay = layout_of(shape);
-  check_cuda(cudaFuncSetAttribute(fused_field_forward, cudaFuncAttributeMaxDynamicSharedMemorySize, int(lay.scratch)),
+  const auto kernel = lay.tangents ? fused_field_forward<true> : fused_field_forward<false>;
+  check_cuda(cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, int(lay.scratch)),
              "fused_field_mlp", "setting the forward kernel's shared memory");
-  fused_field_forward<<<blocks_for(shape, multiprocessors), kThreads, lay.scratch, stream>>>(shape, lay, weights,
-                                                                                             inputs, value, jacobian);
+  kernel<<<blocks_for(shape, multiprocessors), kThreads, lay.scratch, stream>>>(shape, lay, weights, inputs, value,
+                                                                                jacobian);
   check_launch("fused_field_mlp", "fused_field_forward");
 }
 
@@ -619,11 +670,12 @@ void backward(const Shape& shape, const Weights& weights, const Inputs& inputs, 
               float* grad_condition, const Products& products, int multiprocessors, cudaStream_t stream) {
   if (shape.points == 0) return;
   const Layout lay = layout_of(shape);
-  check_cuda(cudaFuncSetAttribute(fused_field_backward, cudaFuncAttributeMaxDynamicSharedMemorySize, int(lay.end)),
+  const auto kernel = lay.tangents ? fused_field_backward<true> : fused_field_backward<false>;
+  check_cuda(cudaFuncSetAttribute(kernel, cudaFuncAttributeMaxDynamicSharedMemorySize, int(lay.end)),
              "fused_field_mlp", "setting the backward kernel's shared memory");
-  fused_field_backward<<<blocks_for(shape, multiprocessors), kThreads, lay.end, stream>>>(
-      shape, lay, weights, inputs, grad_value, grad_jacobian, grad_encoding, grad_derivatives, grad_condition,
-      products);
+  kernel<<<blocks_for(shape, multiprocessors), kThreads, lay.end, stream>>>(shape, lay, weights, inputs, grad_value,
+                                                                            grad_jacobian, grad_encoding,
+                                                                            grad_derivatives, grad_condition, products);
   check_launch("fused_field_mlp", "fused_field_backward");
 }
 

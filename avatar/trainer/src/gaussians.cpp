@@ -88,7 +88,7 @@ at::Tensor gaussian_order(const Gaussians& g) {
 }
 
 Gaussians gaussians_from_tensors(const std::map<std::string, at::Tensor>& tensors, const at::Device& device,
-                                 bool rigged) {
+                                 bool rigged, int64_t triangles) {
   Gaussians g;
   g.rigged = rigged;
   for (const auto& name : Gaussians::parameter_names()) {
@@ -96,10 +96,20 @@ Gaussians gaussians_from_tensors(const std::map<std::string, at::Tensor>& tensor
     if (it == tensors.end()) throw Error("checkpoint has no tensor 'gaussians." + name + "'");
     g.parameter(name) = it->second.to(device).detach().requires_grad_(true);
   }
-  auto bound = tensors.find("gaussians.bound_triangle");
-  if (bound != tensors.end()) g.bound_triangle = bound->second.to(device);
-  auto birth = tensors.find("gaussians.birth_triangle");
-  if (birth != tensors.end()) g.birth_triangle = birth->second.to(device);
+  // Triangle indices, checked here: the GPU's uvd -> world reads its tables at them unchecked.
+  const auto triangle_indices = [&](const std::string& name) {
+    auto it = tensors.find("gaussians." + name);
+    if (it == tensors.end()) return at::Tensor();
+    const at::Tensor& t = it->second;
+    if (t.dim() != 1 || t.size(0) != g.uvd.size(0))
+      throw Error("checkpoint's 'gaussians." + name + "' is not one index per Gaussian");
+    if (t.numel() > 0 && (t.min().item<int64_t>() < 0 || t.max().item<int64_t>() >= triangles))
+      throw Error("checkpoint's 'gaussians." + name + "' holds triangle indices outside the template's " +
+                  std::to_string(triangles) + " triangles");
+    return t.to(device);
+  };
+  g.bound_triangle = triangle_indices("bound_triangle");
+  g.birth_triangle = triangle_indices("birth_triangle");
   if (rigged && !g.bound_triangle.defined()) throw Error("checkpoint of a rigged run has no 'gaussians.bound_triangle'");
   return g;
 }

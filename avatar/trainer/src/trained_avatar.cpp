@@ -17,7 +17,8 @@ TrainedAvatar load_avatar(const std::filesystem::path& run, const Dataset& datas
 
   TrainedAvatar avatar{options, AvatarModel(dataset, options, device), {}, checkpoint.iteration()};
   check_uv_layout(checkpoint, file, avatar.model, dataset.template_mesh, options.binding == "rigged");
-  avatar.model.gaussians = gaussians_from_tensors(checkpoint.tensors, device, options.binding == "rigged");
+  avatar.model.gaussians = gaussians_from_tensors(checkpoint.tensors, device, options.binding == "rigged",
+                                                  avatar.model.lookup().num_triangles());
   nn::load_module_tensors(*avatar.model.network, checkpoint.tensors, file, "network.");
   avatar.phase.deformation = options.deformation_field;
   avatar.phase.shading = options.dynamic_shading;

@@ -578,7 +578,8 @@ class Run {
 
   void restore(const Checkpoint& c, const fs::path& file) {
     check_uv_layout(c, file, model_, dataset_.template_mesh, options_.binding == "rigged");
-    model_.gaussians = gaussians_from_tensors(c.tensors, device_, options_.binding == "rigged");
+    model_.gaussians = gaussians_from_tensors(c.tensors, device_, options_.binding == "rigged",
+                                               model_.lookup().num_triangles());
     nn::load_module_tensors(*model_.network, c.tensors, file, "network.");
     register_parameters();
     adam_.load_state(c.tensors);

@@ -74,9 +74,14 @@ UvdMapping uvd_to_world(const at::Tensor& uvd, const PosedMesh& mesh, const UvTr
     TORCH_CHECK(bound_triangle.dim() == 1 && bound_triangle.size(0) == uvd.size(0),
                 "uvd_to_world: bound_triangle must be [N]");
     triangle = bound_triangle.to(at::kLong);
-    // The fused evaluation reads the tables at these indices unchecked.
-    TORCH_CHECK(!((triangle < 0) | (triangle >= lookup.num_triangles())).any().item<bool>(),
-                "uvd_to_world: bound_triangle out of range");
+    // The fused evaluation reads the tables at these indices unchecked. On the
+    // GPU the check is queued, not read back: reading it waited for all queued
+    // work every training step (checkpoints' indices are checked on loading).
+    const at::Tensor in_range = ((triangle >= 0) & (triangle < lookup.num_triangles())).all();
+    if (triangle.is_cuda())
+      at::_assert_async(in_range);
+    else
+      TORCH_CHECK(in_range.item<bool>(), "uvd_to_world: bound_triangle out of range");
     mapped_uv = uv.detach();
   } else {
     const UvHit hit = lookup.lookup(uv);

@@ -5,6 +5,7 @@
 #include <ATen/CPUGeneratorImpl.h>
 #include <gtest/gtest.h>
 
+#include "tega/core/error.h"
 #include "tega/core/mesh.h"
 
 namespace {
@@ -143,3 +144,26 @@ TEST_F(DensifierTest, WorldSizeIsClampedToTheLimits) {
 }
 
 }  // namespace
+
+// A checkpoint's triangle indices are checked as it loads: the GPU's uvd ->
+// world reads its tables at them without a check of its own.
+TEST_F(DensifierTest, CheckpointTensorsWithTrianglesOutsideTheTemplateAreRefused) {
+  for (const bool bound : {true, false}) {
+    const std::string name = bound ? "bound_triangle" : "birth_triangle";
+    const Gaussians original = initialise_gaussians(lookup, 100, 0.25, bound, 3, at::TensorOptions(at::kFloat));
+    std::map<std::string, at::Tensor> tensors = original.tensors();
+    const Gaussians loaded = gaussians_from_tensors(tensors, at::kCPU, false, lookup.num_triangles());
+    EXPECT_TRUE(at::equal(bound ? loaded.bound_triangle : loaded.birth_triangle, tensors.at("gaussians." + name)));
+
+    tensors["gaussians." + name] = tensors.at("gaussians." + name).clone();
+    tensors["gaussians." + name][7] = lookup.num_triangles();
+    try {
+      gaussians_from_tensors(tensors, at::kCPU, false, lookup.num_triangles());
+      ADD_FAILURE() << name << " out of range was accepted";
+    } catch (const tega::Error& e) {
+      EXPECT_NE(std::string(e.what()).find("'gaussians." + name + "' holds triangle indices outside the template's 2"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+}

@@ -64,9 +64,10 @@ at::Tensor gaussian_order(const Gaussians& g);
 // backward alone took ~18 ms per field at 4M Gaussians on an H100.
 at::Tensor uv_order(const at::Tensor& uv);
 
-// Rebuilds from checkpoint tensors; throws tega::Error naming what is missing.
+// Rebuilds from checkpoint tensors; throws tega::Error naming what is missing
+// or a triangle index outside [0, triangles) (the template's triangle count).
 // `rigged`: the run's binding is rigged (its checkpoint then holds bound_triangle).
 Gaussians gaussians_from_tensors(const std::map<std::string, at::Tensor>& tensors, const at::Device& device,
-                                 bool rigged);
+                                 bool rigged, int64_t triangles);
 
 }  // namespace tega::trainer
