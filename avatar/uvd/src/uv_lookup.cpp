@@ -1,10 +1,14 @@
 #include "tega/uvd/uv_lookup.h"
 
 #include <ATen/CPUGeneratorImpl.h>
+#include <ATen/Dispatch.h>
+#include <ATen/Parallel.h>
 
 #include <cmath>
 
 #include "lookup_builder.h"
+#include "tega/avatar/device_dispatch.h"
+#include "uv_lookup_glue.h"
 
 namespace tega::uvd {
 
@@ -34,72 +38,45 @@ at::Tensor UvTriangleLookup::barycentrics_in(const at::Tensor& uv, const at::Ten
   return at::cat({1 - b12.sum(1, /*keepdim=*/true), b12}, 1);
 }
 
-std::tuple<at::Tensor, at::Tensor, at::Tensor> UvTriangleLookup::closest_points(const at::Tensor& uv,
-                                                                               const at::Tensor& triangle) const {
-  const Tables& t = tables(uv.scalar_type());
-  const auto corners = t.corners.index_select(0, triangle);  // [P,3,2]
-  const auto b = barycentrics_in(uv, triangle);
-  const auto inside = std::get<0>(b.min(1)) >= 0;
-  // Closest points on the three edges; edge k runs from corner k to corner k+1.
-  const auto edge = corners.roll(-1, 1) - corners;
-  const auto offset = uv.unsqueeze(1) - corners;
-  const auto s = ((offset * edge).sum(-1) / (edge * edge).sum(-1)).clamp(0, 1);  // [P,3]
-  const auto on_edge = corners + s.unsqueeze(-1) * edge;
-  const auto [edge_distance2, k] = (uv.unsqueeze(1) - on_edge).pow(2).sum(-1).min(1);
-  const auto point = on_edge.gather(1, k.view({-1, 1, 1}).expand({-1, 1, 2})).squeeze(1);
-  const auto eye = at::eye(3, uv.options());
-  const auto edge_b = (1 - s).unsqueeze(-1) * eye + s.unsqueeze(-1) * eye.roll(1, 1);  // [P,edge,corner]
-  const auto point_b = edge_b.gather(1, k.view({-1, 1, 1}).expand({-1, 1, 3})).squeeze(1);
-  return {at::where(inside, at::zeros_like(edge_distance2), edge_distance2),
-          at::where(inside.unsqueeze(1), uv, point), at::where(inside.unsqueeze(1), b, point_b)};
-}
-
-UvTriangleLookup::Nearest UvTriangleLookup::nearest_candidate(const at::Tensor& uv, const at::Tensor& start,
-                                                               const at::Tensor& count) const {
-  // One row per (query, candidate); keep the first closest candidate of each query.
-  const int64_t n = uv.size(0);
-  const auto long_options = start.options();
-  const auto owner = at::repeat_interleave(at::arange(n, long_options), count);
-  const int64_t pairs = owner.size(0);
-  const auto pair_index = at::arange(pairs, long_options);
-  const auto rank = pair_index - (count.cumsum(0) - count).index_select(0, owner);
-  const auto candidate = cell_triangles_.index_select(0, start.index_select(0, owner) + rank).to(at::kLong);
-  const auto [d2, q, b] = closest_points(uv.index_select(0, owner), candidate);
-  const auto best = at::full({n}, INFINITY, d2.options()).scatter_reduce(0, owner, d2, "amin");
-  const auto key = at::where(d2 <= best.index_select(0, owner), pair_index, at::full_like(pair_index, pairs));
-  const auto chosen = at::full({n}, pairs, long_options).scatter_reduce(0, owner, key, "amin");
-  return {candidate.index_select(0, chosen), d2.index_select(0, chosen), q.index_select(0, chosen),
-          b.index_select(0, chosen)};
+template <typename T>
+uv_lookup::Grid<T> UvTriangleLookup::grid() const {
+  const Tables& t = tables(c10::CppTypeToScalarType<T>::value);
+  uv_lookup::Grid<T> g;
+  g.cell_offsets = cell_offsets_.data_ptr<int32_t>();
+  g.cell_triangles = cell_triangles_.data_ptr<int32_t>();
+  g.corners = t.corners.data_ptr<T>();
+  g.inverse = t.inverse.data_ptr<T>();
+  for (int axis = 0; axis < 2; ++axis) {
+    g.cells[axis] = cells_[axis];
+    g.origin[axis] = T(origin_[axis]);
+    g.texel[axis] = T(texel_[axis]);
+  }
+  return g;
 }
 
 UvHit UvTriangleLookup::lookup(const at::Tensor& uv_in) const {
   TORCH_CHECK(uv_in.dim() == 2 && uv_in.size(1) == 2, "uv lookup: uv must be [N,2]");
   TORCH_CHECK(uv_in.device() == device(), "uv lookup: uv is on ", uv_in.device(), ", the lookup on ", device());
-  const auto uv = uv_in.detach();
+  const at::Tensor uv = uv_in.detach().contiguous();
   const int64_t n = uv.size(0);
-  if (n == 0) return {at::empty({0}, uv.options().dtype(at::kLong)), uv.new_empty({0, 3}), uv.clone(), uv.new_empty({0})};
-  auto texel = [&](int axis) {
-    return ((uv.select(1, axis) - origin_[axis]) / texel_[axis]).floor().clamp(0, cells_[axis] - 1).to(at::kLong);
-  };
-  const auto cell = texel(1) * cells_[0] + texel(0);
-  const auto start = cell_offsets_.index_select(0, cell).to(at::kLong);
-  const auto count = cell_offsets_.index_select(0, cell + 1).to(at::kLong) - start;
-
-  // A texel's first candidate contains its centre (where one does), so most
-  // valid queries are settled by it; the rest try all their candidates.
-  Nearest found;
-  found.triangle = cell_triangles_.index_select(0, start).to(at::kLong);
-  std::tie(found.distance2, found.point, found.barycentrics) = closest_points(uv, found.triangle);
-  const auto unsettled = ((found.distance2 > 0) & (count > 1)).nonzero().view({-1});
-  if (unsettled.size(0) > 0) {
-    const Nearest rest =
-        nearest_candidate(uv.index_select(0, unsettled), start.index_select(0, unsettled), count.index_select(0, unsettled));
-    found.triangle.index_copy_(0, unsettled, rest.triangle);
-    found.distance2.index_copy_(0, unsettled, rest.distance2);
-    found.point.index_copy_(0, unsettled, rest.point);
-    found.barycentrics.index_copy_(0, unsettled, rest.barycentrics);
-  }
-  return {found.triangle, found.barycentrics, found.point, found.distance2.sqrt()};
+  UvHit hit{at::empty({n}, uv.options().dtype(at::kLong)), at::empty({n, 3}, uv.options()),
+            at::empty({n, 2}, uv.options()), at::empty({n}, uv.options())};
+  AT_DISPATCH_FLOATING_TYPES(uv.scalar_type(), "uv lookup", [&] {
+    const uv_lookup::Grid<scalar_t> g = grid<scalar_t>();
+    const uv_lookup::Answers<scalar_t> out{hit.triangle.data_ptr<int64_t>(), hit.barycentrics.data_ptr<scalar_t>(),
+                                           hit.uv.data_ptr<scalar_t>(), hit.distance.data_ptr<scalar_t>()};
+    if (use_cuda_kernels(uv, "uv lookup")) {
+#if defined(TEGA_HAVE_CUDA) && defined(TEGA_TORCH_HAS_CUDA)
+      uv_lookup::lookup_cuda(g, uv, out);
+#endif
+    } else {
+      const scalar_t* queries = uv.data_ptr<scalar_t>();
+      at::parallel_for(0, n, 4096, [&](int64_t begin, int64_t end) {
+        for (int64_t i = begin; i < end; ++i) uv_lookup::lookup_point(g, queries, i, out);
+      });
+    }
+  });
+  return hit;
 }
 
 at::Tensor UvTriangleLookup::project_to_valid_uv(const at::Tensor& uv) const { return lookup(uv).uv; }

@@ -143,8 +143,6 @@ TEST_F(DensifierTest, WorldSizeIsClampedToTheLimits) {
   EXPECT_NEAR(world.min().item<double>(), 2e-5, 1e-10);
 }
 
-}  // namespace
-
 // A checkpoint's triangle indices are checked as it loads: the GPU's uvd ->
 // world reads its tables at them without a check of its own.
 TEST_F(DensifierTest, CheckpointTensorsWithTrianglesOutsideTheTemplateAreRefused) {
@@ -167,3 +165,5 @@ TEST_F(DensifierTest, CheckpointTensorsWithTrianglesOutsideTheTemplateAreRefused
     }
   }
 }
+
+}  // namespace

@@ -11,10 +11,11 @@
 //    (on a shared edge, either triangle);
 //  - a uv outside every triangle (in a hole, across a seam, beyond the chart)
 //    returns the closest point of the nearest triangle.
-// Queries are tensor ops, so they run on the device of the lookup's tensors
-// (move it with to()). Exactness holds inside the grid's domain; a uv beyond
-// it is answered from the nearest border texel's candidates, so it lands on a
-// triangle, not necessarily the nearest (such a uv means nothing anyway).
+// Queries run on the device of the lookup's tensors (move it with to()): a
+// loop on the CPU, a kernel on the GPU that never waits for the device.
+// Exactness holds inside the grid's domain; a uv beyond it is answered from
+// the nearest border texel's candidates, so it lands on a triangle, not
+// necessarily the nearest (such a uv means nothing anyway).
 // Only active triangles are returned; zero-area UV triangles never are.
 // UV islands must not overlap among the active triangles (ICT-FaceKit's eyes,
 // eye blend and occlusion meshes share the face's UV tile, so activate the
@@ -24,10 +25,14 @@
 #include <ATen/ATen.h>
 
 #include <cstdint>
-#include <tuple>
 #include <vector>
 
 #include "tega/core/mesh.h"
+
+namespace tega::uvd::uv_lookup {
+template <typename T>
+struct Grid;
+}
 
 namespace tega::uvd {
 
@@ -99,14 +104,9 @@ class UvTriangleLookup {
   };
   const Tables& tables(at::ScalarType dtype) const;
   static Tables tables_to(const Tables& t, const at::Device& device);
-  // Closest points of uv [P,2] on triangles [P]: squared distance [P], point [P,2], its barycentrics [P,3].
-  std::tuple<at::Tensor, at::Tensor, at::Tensor> closest_points(const at::Tensor& uv, const at::Tensor& triangle) const;
-
-  struct Nearest {
-    at::Tensor triangle, distance2, point, barycentrics;
-  };
-  // The closest of the candidates [start, start+count) of every query.
-  Nearest nearest_candidate(const at::Tensor& uv, const at::Tensor& start, const at::Tensor& count) const;
+  // The grid and tables as raw pointers for the per-query loop and kernel.
+  template <typename T>
+  uv_lookup::Grid<T> grid() const;
 
   int cells_[2] = {0, 0};      // texels along u and v
   double origin_[2] = {0, 0};  // uv of the grid's lower-left corner
