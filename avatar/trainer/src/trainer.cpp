@@ -391,13 +391,17 @@ class Run {
     return host.pin_memory().to(device_, /*non_blocking=*/true);
   }
 
-  // Whether the loss and every gradient are finite, as a 0-d bool tensor on the device.
+  // Whether the loss and every gradient are finite, as a 0-d bool tensor on the
+  // device. One pass over each gradient: its smallest and largest element,
+  // NaN where one is (aminmax propagates NaN), ±Inf where one is.
   at::Tensor all_finite(const at::Tensor& loss) const {
-    std::vector<at::Tensor> finite{at::isfinite(loss).all()};
+    std::vector<at::Tensor> extremes{loss.detach().reshape({1}).to(at::kDouble)};
     for (const auto& g : adam_.groups()) {
-      if (g.parameter.grad().defined()) finite.push_back(at::isfinite(g.parameter.grad()).all());
+      if (!g.parameter.grad().defined() || g.parameter.grad().numel() == 0) continue;
+      const auto [lowest, highest] = at::aminmax(g.parameter.grad());
+      extremes.push_back(at::stack({lowest, highest}).to(at::kDouble));
     }
-    return at::stack(finite).all();
+    return at::isfinite(at::cat(extremes)).all();
   }
 
   // What went wrong in a step ("" if nothing): a NaN/Inf, or a deformation
