@@ -5,9 +5,8 @@
 
 #include <cuda_bf16.h>
 
-#include <algorithm>
-
 #include "tega/core/cuda_check.h"
+#include "tega/core/cuda_grid.h"
 #include "silu_tangents_kernels.h"
 #include "silu_tangents_math.h"
 
@@ -60,16 +59,11 @@ __global__ void backward_kernel(int64_t count, int64_t width, const S* __restric
   }
 }
 
-unsigned blocks_for(int64_t count) {
-  constexpr int64_t kMaxBlocks = 132 * 64;  // enough to fill an H100; the loops stride over the rest
-  return unsigned(std::min<int64_t>((count + kThreads - 1) / kThreads, kMaxBlocks));
-}
-
 template <typename S>
 void launch_forward(int64_t rows, int64_t width, const S* pre, const S* tangents, S* h, S* u, cudaStream_t stream) {
   const int64_t count = rows * width;
   if (count == 0) return;
-  forward_kernel<<<blocks_for(count), kThreads, 0, stream>>>(count, width, pre, tangents, h, u);
+  forward_kernel<<<grid_stride_blocks(count, kThreads), kThreads, 0, stream>>>(count, width, pre, tangents, h, u);
   check_launch("silu_with_tangents", "forward_kernel");
 }
 
@@ -78,8 +72,8 @@ void launch_backward(int64_t rows, int64_t width, const S* pre, const S* tangent
                      S* grad_x, S* grad_t, cudaStream_t stream) {
   const int64_t count = rows * width;
   if (count == 0) return;
-  backward_kernel<<<blocks_for(count), kThreads, 0, stream>>>(count, width, pre, tangents, grad_h, grad_u, grad_x,
-                                                              grad_t);
+  backward_kernel<<<grid_stride_blocks(count, kThreads), kThreads, 0, stream>>>(count, width, pre, tangents, grad_h,
+                                                                                grad_u, grad_x, grad_t);
   check_launch("silu_with_tangents", "backward_kernel");
 }
 

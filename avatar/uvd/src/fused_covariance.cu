@@ -1,9 +1,8 @@
 // One thread per Gaussian: its 16 inputs and 6 outputs are contiguous, and a
 // warp's accesses cover contiguous memory, which the caches coalesce.
 
-#include <algorithm>
-
 #include "tega/core/cuda_check.h"
+#include "tega/core/cuda_grid.h"
 #include "fused_covariance_kernels.h"
 #include "fused_covariance_math.h"
 
@@ -31,19 +30,14 @@ __global__ void backward_kernel(int64_t n, const T* __restrict__ jacobian, const
                      grad_jacobian + 9 * i, grad_quaternion + 4 * i, grad_log_scale + 3 * i);
 }
 
-unsigned blocks_for(int64_t count) {
-  constexpr int64_t kMaxBlocks = 132 * 64;  // enough to fill an H100; the loops stride over the rest
-  return unsigned(std::min<int64_t>((count + kThreads - 1) / kThreads, kMaxBlocks));
-}
-
 }  // namespace
 
 template <typename T>
 void forward(int64_t n, const T* jacobian, const T* quaternion, const T* log_scale, T* covariance, T* std_per_scale,
              cudaStream_t stream) {
   if (n == 0) return;
-  forward_kernel<<<blocks_for(n), kThreads, 0, stream>>>(n, jacobian, quaternion, log_scale, covariance,
-                                                         std_per_scale);
+  forward_kernel<<<grid_stride_blocks(n, kThreads), kThreads, 0, stream>>>(n, jacobian, quaternion, log_scale,
+                                                                           covariance, std_per_scale);
   check_launch("world_covariance_packed", "forward_kernel");
 }
 
@@ -51,8 +45,8 @@ template <typename T>
 void backward(int64_t n, const T* jacobian, const T* quaternion, const T* log_scale, const T* grad_covariance,
               T* grad_jacobian, T* grad_quaternion, T* grad_log_scale, cudaStream_t stream) {
   if (n == 0) return;
-  backward_kernel<<<blocks_for(n), kThreads, 0, stream>>>(n, jacobian, quaternion, log_scale, grad_covariance,
-                                                          grad_jacobian, grad_quaternion, grad_log_scale);
+  backward_kernel<<<grid_stride_blocks(n, kThreads), kThreads, 0, stream>>>(
+      n, jacobian, quaternion, log_scale, grad_covariance, grad_jacobian, grad_quaternion, grad_log_scale);
   check_launch("world_covariance_packed", "backward_kernel");
 }
 

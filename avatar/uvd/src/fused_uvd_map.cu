@@ -2,9 +2,8 @@
 // corners' positions and normals (scattered reads that the caches serve, the
 // mesh being small next to the points), and reads and writes its own rows.
 
-#include <algorithm>
-
 #include "tega/core/cuda_check.h"
+#include "tega/core/cuda_grid.h"
 #include "fused_uvd_map_kernels.h"
 
 namespace tega::uvd::fused_uvd_map::cuda {
@@ -29,18 +28,14 @@ __global__ void backward_kernel(int64_t n, Surface<T> surface, const int64_t* __
                      grad_jacobian ? grad_jacobian + 9 * i : nullptr, grad_uvd + 3 * i);
 }
 
-unsigned blocks_for(int64_t count) {
-  constexpr int64_t kMaxBlocks = 132 * 64;  // enough to fill an H100; the loops stride over the rest
-  return unsigned(std::min<int64_t>((count + kThreads - 1) / kThreads, kMaxBlocks));
-}
-
 }  // namespace
 
 template <typename T>
 void forward(int64_t n, const Surface<T>& surface, const int64_t* triangle, const T* uv, const T* uvd, T* xyz,
              T* jacobian, cudaStream_t stream) {
   if (n == 0) return;
-  forward_kernel<<<blocks_for(n), kThreads, 0, stream>>>(n, surface, triangle, uv, uvd, xyz, jacobian);
+  forward_kernel<<<grid_stride_blocks(n, kThreads), kThreads, 0, stream>>>(n, surface, triangle, uv, uvd, xyz,
+                                                                           jacobian);
   check_launch("uvd_to_world", "forward_kernel");
 }
 
@@ -48,8 +43,8 @@ template <typename T>
 void backward(int64_t n, const Surface<T>& surface, const int64_t* triangle, const T* uv, const T* uvd,
               const T* grad_xyz, const T* grad_jacobian, T* grad_uvd, cudaStream_t stream) {
   if (n == 0) return;
-  backward_kernel<<<blocks_for(n), kThreads, 0, stream>>>(n, surface, triangle, uv, uvd, grad_xyz, grad_jacobian,
-                                                          grad_uvd);
+  backward_kernel<<<grid_stride_blocks(n, kThreads), kThreads, 0, stream>>>(n, surface, triangle, uv, uvd, grad_xyz,
+                                                                            grad_jacobian, grad_uvd);
   check_launch("uvd_to_world", "backward_kernel");
 }
 

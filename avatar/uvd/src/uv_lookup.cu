@@ -2,9 +2,8 @@
 // inverse tables (a few scattered reads that the caches serve, the layout
 // being small next to the queries).
 
-#include <algorithm>
-
 #include "tega/core/cuda_check.h"
+#include "tega/core/cuda_grid.h"
 #include "uv_lookup_kernels.h"
 
 namespace tega::uvd::uv_lookup::cuda {
@@ -23,9 +22,7 @@ __global__ void lookup_kernel(int64_t n, Grid<T> grid, const T* __restrict__ uv,
 template <typename T>
 void lookup(int64_t n, const Grid<T>& grid, const T* uv, const Answers<T>& out, cudaStream_t stream) {
   if (n == 0) return;
-  constexpr int64_t kMaxBlocks = 132 * 64;  // enough to fill an H100; the loop strides over the rest
-  const auto blocks = unsigned(std::min<int64_t>((n + kThreads - 1) / kThreads, kMaxBlocks));
-  lookup_kernel<<<blocks, kThreads, 0, stream>>>(n, grid, uv, out);
+  lookup_kernel<<<grid_stride_blocks(n, kThreads), kThreads, 0, stream>>>(n, grid, uv, out);
   check_launch("uv lookup", "lookup_kernel");
 }
 
