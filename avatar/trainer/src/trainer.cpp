@@ -395,13 +395,13 @@ class Run {
   // device. One pass over each gradient: its smallest and largest element,
   // NaN where one is (aminmax propagates NaN), ±Inf where one is.
   at::Tensor all_finite(const at::Tensor& loss) const {
-    std::vector<at::Tensor> extremes{loss.detach().reshape({1}).to(at::kDouble)};
+    std::vector<at::Tensor> extremes{loss.detach().reshape({})};
     for (const auto& g : adam_.groups()) {
       if (!g.parameter.grad().defined() || g.parameter.grad().numel() == 0) continue;
       const auto [lowest, highest] = at::aminmax(g.parameter.grad());
-      extremes.push_back(at::stack({lowest, highest}).to(at::kDouble));
+      extremes.insert(extremes.end(), {lowest, highest});
     }
-    return at::isfinite(at::cat(extremes)).all();
+    return at::isfinite(at::stack(extremes)).all();
   }
 
   // What went wrong in a step ("" if nothing): a NaN/Inf, or a deformation
