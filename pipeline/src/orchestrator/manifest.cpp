@@ -19,7 +19,7 @@ std::vector<OutputFile> hash_outputs(const fs::path& shard_dir) {
   for (const auto& entry : fs::recursive_directory_iterator(shard_dir)) {
     if (!entry.is_regular_file()) continue;
     const std::string relative = fs::relative(entry.path(), shard_dir).generic_string();
-    if (relative == kManifestFile) continue;
+    if (relative == kManifestFile || relative == kResumeKeyFile) continue;
     outputs.push_back({relative, entry.file_size(), sha256_file(entry.path())});
   }
   std::sort(outputs.begin(), outputs.end(), [](const auto& a, const auto& b) { return a.path < b.path; });

@@ -318,7 +318,6 @@ class Run {
     for (const auto& [artifact, path] : stage.kind->provides) {
       if (!fs::exists(staging / path)) throw Error(staging / path, "was not produced by the shard's command");
     }
-    fs::remove(staging / kResumeKeyFile);
     Manifest m;
     m.stage = stage.name();
     m.shard = subject;
@@ -334,7 +333,10 @@ class Run {
     m.outputs = hash_outputs(staging);
     m.output_hash = outputs_hash(m.outputs);
     write_manifest(staging / kManifestFile, m);
+    // The resume key goes last: killed before the rename, the next run keeps
+    // the staged outputs (a whole training run) rather than starting over.
     ws_.commit(stage.name(), subject);
+    fs::remove(ws_.shard_dir(stage.name(), subject) / kResumeKeyFile);
     fs::remove(ws_.state_file(stage.name(), subject));
     s.output_hash = m.output_hash;
   }

@@ -16,7 +16,8 @@ namespace tega::pipeline {
 
 inline constexpr const char* kManifestFile = "manifest.json";
 // In the staging directory of a shard whose kind resumes there: the
-// fingerprint key its partial outputs were made for (removed at commit).
+// fingerprint key its partial outputs were made for. Not an output: removed
+// once the commit has renamed the directory into place.
 inline constexpr const char* kResumeKeyFile = ".resume-key";
 
 struct OutputFile {
