@@ -2,14 +2,14 @@
 // texels' channels contiguously (the latent is channels-last), so the loads
 // coalesce.
 //
-// Backward: the trainer keeps the points sorted by uv cell, so consecutive
-// points mostly share their four taps. Each lane walks a run of kRun points
-// for a few channels, holding per tap corner k the texel it last saw there,
-// that texel's channel values and the gradient summed into it since. Only
-// when corner k's texel changes, and at the end of the run, does the sum go
-// to grad_latent with an atomic add: with ~60 points per texel about 30x
-// fewer atomics than one per point and tap. Any order is still right (an
-// unsorted one just flushes at every point). The uv gradient sums over the
+// Backward: the trainer keeps the points sorted by their top-left tap
+// (uv_order), so consecutive points mostly share their four taps. Each lane
+// walks a run of kRun points for a few channels, holding per tap corner k the
+// texel it last saw there, that texel's channel values and the gradient
+// summed into it since. Only when corner k's texel changes, and at the end of
+// the run, does the sum go to grad_latent with an atomic add: with ~60 points
+// per texel about 30x fewer atomics than one per point and tap. Any order is
+// still right (an unsorted one just flushes at every point). The uv gradient sums over the
 // channels with warp shuffles, then one atomic add per point and chunk of
 // channels.
 //

@@ -41,7 +41,7 @@ void rebuild(Gaussians& g, Adam& adam, const at::Tensor& keep, const std::map<st
 }  // namespace
 
 DensifyResult densify(Gaussians& g, Adam& adam, const DensifyStats& stats, const DensifyOptions& options,
-                      const uvd::UvTriangleLookup& lookup, at::Generator& generator) {
+                      const uvd::UvTriangleLookup& lookup, int64_t latent_side, at::Generator& generator) {
   at::NoGradGuard no_grad;
   const int64_t n = g.size();
   const at::Tensor mean_gradient = stats.gradient_norm_sum / stats.visible_count.clamp_min(1).to(at::kFloat);
@@ -93,7 +93,7 @@ DensifyResult densify(Gaussians& g, Adam& adam, const DensifyStats& stats, const
   const at::Tensor keep = split.logical_or(prune).logical_not().nonzero().flatten();
   rebuild(g, adam, keep, appended, appended_bound, appended_birth);
   // The new rows went to the end: back into order (see gaussians.h).
-  rebuild(g, adam, gaussian_order(g), {}, {}, {});
+  rebuild(g, adam, gaussian_order(g, latent_side), {}, {}, {});
 
   DensifyResult r;
   r.cloned = clone_ids.size(0);

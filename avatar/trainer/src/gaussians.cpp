@@ -35,19 +35,23 @@ std::map<std::string, at::Tensor> Gaussians::tensors() const {
   return t;
 }
 
-at::Tensor uv_order(const at::Tensor& uv) {
-  constexpr int64_t kCells = 256;
-  const at::Tensor cell = (uv.slice(1, 0, 2).detach() * kCells).floor().clamp(0, kCells - 1).to(at::kLong);
-  const at::Tensor key = (kCells - 1 - cell.select(1, 1)) * kCells + cell.select(1, 0);  // top row (v = 1) first
-  return std::get<1>(key.sort(/*stable=*/true, /*dim=*/0, /*descending=*/false));
+at::Tensor uv_order(const at::Tensor& uv, int64_t latent_side) {
+  TORCH_CHECK(latent_side >= 1, "uv_order: latent_side must be positive, got ", latent_side);
+  // The top-left tap's column and row, as sample_latent finds them: texel
+  // centres at (c + 0.5)/W and v = 1 - (r + 0.5)/H, clamped at the border.
+  const at::Tensor u = uv.select(1, 0).detach(), v = uv.select(1, 1).detach();
+  const auto tap = [&](const at::Tensor& pixel) { return pixel.floor().clamp(0, latent_side - 1).to(at::kLong); };
+  const at::Tensor column = tap(u * latent_side - 0.5), row = tap((1 - v) * latent_side - 0.5);
+  return std::get<1>((row * latent_side + column).sort(/*stable=*/true, /*dim=*/0, /*descending=*/false));
 }
 
 Gaussians initialise_gaussians(const uvd::UvTriangleLookup& lookup, int64_t count, double metres_per_uv,
-                               bool bind_to_triangles, uint64_t seed, const at::TensorOptions& options) {
+                               bool bind_to_triangles, int64_t latent_side, uint64_t seed,
+                               const at::TensorOptions& options) {
   at::NoGradGuard no_grad;
   Gaussians g;
   const at::Tensor sampled = lookup.sample_uniform(count, seed).to(options);
-  const at::Tensor uv = sampled.index_select(0, uv_order(sampled));
+  const at::Tensor uv = sampled.index_select(0, uv_order(sampled, latent_side));
   g.uvd = at::cat({uv, at::zeros({count, 1}, options)}, 1);
   // Mean spacing of `count` points over the valid UV area.
   const double uv_area = lookup.uv_area().sum().item<double>();
@@ -82,8 +86,8 @@ Gaussians initialise_rigged_gaussians(const uvd::UvTriangleLookup& lookup, const
   return g;
 }
 
-at::Tensor gaussian_order(const Gaussians& g) {
-  if (!g.rigged) return uv_order(g.uvd);
+at::Tensor gaussian_order(const Gaussians& g, int64_t latent_side) {
+  if (!g.rigged) return uv_order(g.uvd, latent_side);
   return std::get<1>(g.bound_triangle.sort(/*stable=*/true, /*dim=*/0, /*descending=*/false));
 }
 

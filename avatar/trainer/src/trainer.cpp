@@ -139,7 +139,7 @@ class Run {
       model_.gaussians = options_.binding == "rigged"
                              ? initialise_rigged_gaussians(model_.lookup(), floats)
                              : initialise_gaussians(model_.lookup(), initial, model_.metres_per_uv(),
-                                                    options_.binding == "triangle",
+                                                    options_.binding == "triangle", options_.network.texture_size,
                                                     static_cast<uint64_t>(options_.seed), floats);
       register_parameters();
       stats_ = splat::MeanGradientStats::zeros(model_.gaussians.uvd);
@@ -500,7 +500,8 @@ class Run {
       const double pixels_per_ndc = 0.5 * std::max(camera.width, camera.height);
       parallel_.sum({stats_.grad_norm_sum, stats_.visible_count});  // every process's views count
       DensifyStats stats{stats_.grad_norm_sum * pixels_per_ndc, stats_.visible_count, max_world_std_};
-      const DensifyResult r = densify(model_.gaussians, adam_, stats, d, model_.lookup(), generator_);
+      const DensifyResult r = densify(model_.gaussians, adam_, stats, d, model_.lookup(),
+                                      options_.network.texture_size, generator_);
       logging::debug("densify at %lld: cloned %lld, split %lld, pruned %lld -> %lld Gaussians",
                      static_cast<long long>(it), static_cast<long long>(r.cloned), static_cast<long long>(r.split),
                      static_cast<long long>(r.pruned), static_cast<long long>(model_.gaussians.size()));

@@ -11,6 +11,8 @@ namespace {
 
 using namespace tega::trainer;
 
+constexpr int64_t kLatentSide = 256;  // the trainer's default latent textures
+
 tega::Mesh one_chart() {
   tega::Mesh m;
   m.positions.resize(3, 3);
@@ -28,7 +30,8 @@ TEST(DensifierCuda, SplitsAndClonesOnTheGpuLikeOnTheCpu) {
   if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";
   const at::Device cuda(at::kCUDA, 0);
   const tega::uvd::UvTriangleLookup lookup = tega::uvd::UvTriangleLookup(one_chart(), {256, 0.1}).to(cuda);
-  Gaussians g = initialise_gaussians(lookup, 100, 0.25, false, 3, at::TensorOptions(at::kFloat).device(cuda));
+  Gaussians g = initialise_gaussians(lookup, 100, 0.25, false, kLatentSide, 3,
+                                     at::TensorOptions(at::kFloat).device(cuda));
   Adam adam;
   for (const auto& name : Gaussians::parameter_names()) adam.add(name, g.parameter(name), 1e-3);
   DensifyStats stats;
@@ -39,7 +42,7 @@ TEST(DensifierCuda, SplitsAndClonesOnTheGpuLikeOnTheCpu) {
   stats.world_std.slice(0, 40).fill_(1e-4);     // clone
   at::Generator generator = at::make_generator<at::CPUGeneratorImpl>(5);
 
-  const DensifyResult r = densify(g, adam, stats, DensifyOptions{}, lookup, generator);
+  const DensifyResult r = densify(g, adam, stats, DensifyOptions{}, lookup, kLatentSide, generator);
   EXPECT_EQ(r.split, 40);
   EXPECT_EQ(r.cloned, 60);
   ASSERT_EQ(g.size(), 60 + 60 + 80);

@@ -12,6 +12,8 @@ namespace {
 
 using namespace tega::trainer;
 
+constexpr int64_t kLatentSide = 256;  // the trainer's default latent textures
+
 // Two separate UV charts (triangles) with a gap between them.
 tega::Mesh two_charts() {
   tega::Mesh m;
@@ -39,7 +41,7 @@ class DensifierTest : public ::testing::Test {
  protected:
   void SetUp() override {
     at::set_num_threads(2);
-    gaussians = initialise_gaussians(lookup, 200, 0.25, false, 3, at::TensorOptions(at::kFloat));
+    gaussians = initialise_gaussians(lookup, 200, 0.25, false, kLatentSide, 3, at::TensorOptions(at::kFloat));
     for (const auto& name : Gaussians::parameter_names()) adam.add(name, gaussians.parameter(name), 1e-3);
   }
   tega::uvd::UvTriangleLookup lookup{two_charts(), {256, 0.1}};
@@ -55,7 +57,7 @@ TEST_F(DensifierTest, SplitChildrenLandOnValidTrianglesAndShrink) {
     gaussians.log_scale.fill_(std::log(0.3));
   }
   DensifyOptions options;
-  const DensifyResult r = densify(gaussians, adam, stats_for(200, 1.0, 0.01), options, lookup, generator);
+  const DensifyResult r = densify(gaussians, adam, stats_for(200, 1.0, 0.01), options, lookup, kLatentSide, generator);
   EXPECT_EQ(r.split, 200);
   EXPECT_EQ(r.cloned, 0);
   ASSERT_EQ(gaussians.size(), 400);
@@ -76,7 +78,7 @@ TEST_F(DensifierTest, BirthTrianglesAreWhereEachGaussianWasCreated) {
     at::NoGradGuard no_grad;
     gaussians.log_scale.fill_(std::log(0.3));  // children spread over the charts
   }
-  densify(gaussians, adam, stats_for(200, 1.0, 0.01), DensifyOptions(), lookup, generator);
+  densify(gaussians, adam, stats_for(200, 1.0, 0.01), DensifyOptions(), lookup, kLatentSide, generator);
   ASSERT_EQ(gaussians.birth_triangle.size(0), gaussians.size());
   EXPECT_TRUE(at::equal(gaussians.birth_triangle, lookup.lookup(gaussians.uvd.detach().slice(1, 0, 2)).triangle));
 }
@@ -87,7 +89,7 @@ TEST_F(DensifierTest, SmallGaussiansAreClonedAndTransparentOnesPruned) {
     gaussians.opacity_logit.slice(0, 0, 50).fill_(-10.0);  // opacity ~ 4.5e-5
   }
   DensifyOptions options;
-  const DensifyResult r = densify(gaussians, adam, stats_for(200, 1.0, 1e-4), options, lookup, generator);
+  const DensifyResult r = densify(gaussians, adam, stats_for(200, 1.0, 1e-4), options, lookup, kLatentSide, generator);
   EXPECT_EQ(r.pruned, 50);
   EXPECT_EQ(r.cloned, 150);
   EXPECT_EQ(gaussians.size(), 300);
@@ -99,12 +101,12 @@ TEST_F(DensifierTest, NeverExceedsTheCapAndPrefersHighGradients) {
   stats.gradient_norm_sum.slice(0, 20, 40).fill_(0.5);
   DensifyOptions options;
   options.max_gaussians = 210;
-  densify(gaussians, adam, stats, options, lookup, generator);
+  densify(gaussians, adam, stats, options, lookup, kLatentSide, generator);
   EXPECT_EQ(gaussians.size(), 210);
 }
 
 TEST_F(DensifierTest, TriangleBindingChildrenInheritTheirTriangle) {
-  gaussians = initialise_gaussians(lookup, 100, 0.25, true, 3, at::TensorOptions(at::kFloat));
+  gaussians = initialise_gaussians(lookup, 100, 0.25, true, kLatentSide, 3, at::TensorOptions(at::kFloat));
   adam = Adam();
   for (const auto& name : Gaussians::parameter_names()) adam.add(name, gaussians.parameter(name), 1e-3);
   {
@@ -112,7 +114,7 @@ TEST_F(DensifierTest, TriangleBindingChildrenInheritTheirTriangle) {
     gaussians.log_scale.fill_(std::log(0.3));
   }
   const at::Tensor before = gaussians.bound_triangle.clone();
-  densify(gaussians, adam, stats_for(100, 1.0, 0.01), DensifyOptions{}, lookup, generator);
+  densify(gaussians, adam, stats_for(100, 1.0, 0.01), DensifyOptions{}, lookup, kLatentSide, generator);
   ASSERT_EQ(gaussians.bound_triangle.size(0), 200);
   // Rows are re-sorted by uv afterwards, so compare how many Gaussians each triangle holds.
   EXPECT_TRUE(at::equal(at::bincount(gaussians.bound_triangle, {}, 2), 2 * at::bincount(before, {}, 2)));
@@ -120,9 +122,10 @@ TEST_F(DensifierTest, TriangleBindingChildrenInheritTheirTriangle) {
 
 TEST_F(DensifierTest, RowsStayInUvOrderWithTheirMoments) {
   adam.group("uvd").first_moment.copy_(gaussians.uvd.detach());  // a moment that identifies its row
-  const DensifyResult r = densify(gaussians, adam, stats_for(200, 1.0, 1e-4), DensifyOptions{}, lookup, generator);
+  const DensifyResult r = densify(gaussians, adam, stats_for(200, 1.0, 1e-4), DensifyOptions{},
+                                  lookup, kLatentSide, generator);
   ASSERT_EQ(r.cloned, 200);
-  EXPECT_TRUE(at::equal(uv_order(gaussians.uvd), at::arange(400, at::kLong)));
+  EXPECT_TRUE(at::equal(uv_order(gaussians.uvd, kLatentSide), at::arange(400, at::kLong)));
   // Originals kept their moments wherever they moved; clones start at zero.
   const at::Tensor m = adam.group("uvd").first_moment;
   const at::Tensor has_moment = m.abs().sum(1) > 0;
@@ -148,7 +151,8 @@ TEST_F(DensifierTest, WorldSizeIsClampedToTheLimits) {
 TEST_F(DensifierTest, CheckpointTensorsWithTrianglesOutsideTheTemplateAreRefused) {
   for (const bool bound : {true, false}) {
     const std::string name = bound ? "bound_triangle" : "birth_triangle";
-    const Gaussians original = initialise_gaussians(lookup, 100, 0.25, bound, 3, at::TensorOptions(at::kFloat));
+    const Gaussians original = initialise_gaussians(lookup, 100, 0.25, bound, kLatentSide, 3,
+                                                    at::TensorOptions(at::kFloat));
     std::map<std::string, at::Tensor> tensors = original.tensors();
     const Gaussians loaded = gaussians_from_tensors(tensors, at::kCPU, false, lookup.num_triangles());
     EXPECT_TRUE(at::equal(bound ? loaded.bound_triangle : loaded.birth_triangle, tensors.at("gaussians." + name)));

@@ -30,9 +30,10 @@ struct DensifyResult {
 
 // One densification: clone small Gaussians with large mean gradients, split
 // large ones into two children (std / 1.6), prune transparent and huge ones,
-// and never exceed options.max_gaussians (highest gradients win).
+// and never exceed options.max_gaussians (highest gradients win). Leaves the
+// Gaussians in gaussian_order for latent textures of side `latent_side`.
 DensifyResult densify(Gaussians& gaussians, Adam& adam, const DensifyStats& stats, const DensifyOptions& options,
-                      const uvd::UvTriangleLookup& lookup, at::Generator& generator);
+                      const uvd::UvTriangleLookup& lookup, int64_t latent_side, at::Generator& generator);
 
 // Caps every opacity at 0.01 (3DGS's periodic reset) and clears its moments.
 void reset_opacity(Gaussians& gaussians, Adam& adam);

@@ -44,9 +44,11 @@ struct Gaussians {
 
 // `count` Gaussians spread uniformly over the valid UV area at d = 0, grey,
 // opacity 0.1, isotropic with a world std equal to their mean spacing, in
-// uv_order. `metres_per_uv` converts uv lengths to metres on the template.
+// uv_order for latent textures of side `latent_side`. `metres_per_uv`
+// converts uv lengths to metres on the template.
 Gaussians initialise_gaussians(const uvd::UvTriangleLookup& lookup, int64_t count, double metres_per_uv,
-                               bool bind_to_triangles, uint64_t seed, const at::TensorOptions& options);
+                               bool bind_to_triangles, int64_t latent_side, uint64_t seed,
+                               const at::TensorOptions& options);
 
 // GaussianAvatars' initialisation: one Gaussian at the centroid of every
 // active triangle (nonzero UV area), isotropic with a local std of half the
@@ -55,14 +57,19 @@ Gaussians initialise_rigged_gaussians(const uvd::UvTriangleLookup& lookup, const
 
 // The memory order the densifier keeps: uv_order for UVD Gaussians, by bound
 // triangle (stable) for rigged ones, whose uvd holds no uv.
-at::Tensor gaussian_order(const Gaussians& g);
+at::Tensor gaussian_order(const Gaussians& g, int64_t latent_side);
 
-// The permutation that sorts Gaussians (uv or uvd rows) by the row-major
-// cell of a 256² grid over uv (stable). Neighbours on the texture then sit together in memory,
-// so the per-Gaussian gathers (mesh corners, latent texels) and the atomic
-// adds of their gradients hit cached lines: without it, the latent sampling's
-// backward alone took ~18 ms per field at 4M Gaussians on an H100.
-at::Tensor uv_order(const at::Tensor& uv);
+// The permutation that sorts Gaussians (uv or uvd rows) by the four texels
+// they read on a latent texture of side `latent_side` (sample_latent's
+// bilinear taps, encoders.h; keyed by the top-left one, rows from the top,
+// stable). Gaussians that read the same texels then sit together in memory:
+// the latent sampling's backward sums their gradients and adds them to the
+// latent's once per run of them, and the per-Gaussian gathers (mesh corners,
+// texels) hit cached lines. Unsorted, that backward took ~18 ms per field at
+// 4M Gaussians on an H100. Sorted by uv cells half a texel off the taps, it
+// still added 3.0 of a Gaussian's 4 taps; in this order 0.13
+// (docs/networks-and-losses.md).
+at::Tensor uv_order(const at::Tensor& uv, int64_t latent_side);
 
 // Rebuilds from checkpoint tensors; throws tega::Error naming what is missing
 // or a triangle index outside [0, triangles) (the template's triangle count).
