@@ -9,9 +9,9 @@
 // summed into it since. Only when corner k's texel changes, and at the end of
 // the run, does the sum go to grad_latent with an atomic add: with ~60 points
 // per texel about 30x fewer atomics than one per point and tap. Any order is
-// still right (an unsorted one just flushes at every point). The uv gradient sums over the
-// channels with warp shuffles, then one atomic add per point and chunk of
-// channels.
+// still right (an unsorted one just flushes at every point). The uv gradient
+// sums over the channels with warp shuffles, then one atomic add per point
+// and chunk of channels.
 //
 // Launch shape: a warp is 32/width groups of `width` lanes, width = 32, or
 // the power of two covering the channels when there are fewer. Lane `member`
