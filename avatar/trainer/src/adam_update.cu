@@ -1,11 +1,19 @@
-// CUDA kernel of the fused Adam update: a grid-stride pass over the elements.
+// CUDA kernels of the fused Adam update: grid-stride passes over the
+// elements. Adam reads four tensors and writes three, so it runs at memory
+// speed; in float, where the tensors allow, four elements a thread move as
+// 16-byte words.
+
+#include <cstdint>
+#include <type_traits>
 
 #include "adam_update_kernels.h"
-
 #include "tega/core/cuda_check.h"
+#include "tega/core/cuda_grid.h"
 
 namespace tega::trainer::adam_update::cuda {
 namespace {
+
+constexpr int kThreads = 256;
 
 template <typename T>
 __global__ void step_kernel(int64_t count, int64_t columns, T* param, const T* grad, T* first_moment,
@@ -15,15 +23,47 @@ __global__ void step_kernel(int64_t count, int64_t columns, T* param, const T* g
                  column_scale ? column_scale[i % columns] : T(1), constants);
 }
 
+__global__ void step_kernel_by_four(int64_t quads, int64_t columns, float4* param, const float4* grad,
+                                    float4* first_moment, float4* second_moment, const float* column_scale,
+                                    Constants<float> constants) {
+  for (int64_t q = int64_t(blockIdx.x) * blockDim.x + threadIdx.x; q < quads; q += int64_t(gridDim.x) * blockDim.x) {
+    float4 p = param[q], m = first_moment[q], v = second_moment[q];
+    const float4 g = grad[q];
+    float scale[4] = {1.0f, 1.0f, 1.0f, 1.0f};
+    if (column_scale) {
+      int64_t column = (4 * q) % columns;
+      for (int k = 0; k < 4; ++k, column = column + 1 == columns ? 0 : column + 1) scale[k] = column_scale[column];
+    }
+    step_element(p.x, g.x, m.x, v.x, scale[0], constants);
+    step_element(p.y, g.y, m.y, v.y, scale[1], constants);
+    step_element(p.z, g.z, m.z, v.z, scale[2], constants);
+    step_element(p.w, g.w, m.w, v.w, scale[3], constants);
+    param[q] = p;
+    first_moment[q] = m;
+    second_moment[q] = v;
+  }
+}
+
+bool aligned16(const void* pointer) { return reinterpret_cast<uintptr_t>(pointer) % 16 == 0; }
+
 }  // namespace
 
 template <typename T>
 void step(int64_t count, int64_t columns, T* param, const T* grad, T* first_moment, T* second_moment,
           const T* column_scale, const Constants<T>& constants, cudaStream_t stream) {
   if (count == 0) return;
-  constexpr int kThreads = 256;
-  const int64_t blocks = (count + kThreads - 1) / kThreads;
-  step_kernel<T><<<unsigned(blocks < 65536 ? blocks : 65536), kThreads, 0, stream>>>(
+  if constexpr (std::is_same_v<T, float>) {
+    if (count % 4 == 0 && aligned16(param) && aligned16(grad) && aligned16(first_moment) &&
+        aligned16(second_moment)) {
+      step_kernel_by_four<<<grid_stride_blocks(count / 4, kThreads), kThreads, 0, stream>>>(
+          count / 4, columns, reinterpret_cast<float4*>(param), reinterpret_cast<const float4*>(grad),
+          reinterpret_cast<float4*>(first_moment), reinterpret_cast<float4*>(second_moment), column_scale,
+          constants);
+      check_launch("adam", "step_kernel_by_four");
+      return;
+    }
+  }
+  step_kernel<T><<<grid_stride_blocks(count, kThreads), kThreads, 0, stream>>>(
       count, columns, param, grad, first_moment, second_moment, column_scale, constants);
   check_launch("adam", "step_kernel");
 }

@@ -148,19 +148,16 @@ PosedGaussians AvatarModel::pose(const FrameInput& frame, const Phase& phase) {
 
   {
     TEGA_TRACE_SCOPE("colors");
-    // The shading multiplier S > 0 folds into the SH coefficients, since
-    // S·max(c, 0) = max(S·c, 0): S·(C0·dc + rest·Y + ½) = C0·dc' + rest'·Y + ½
-    // with rest' = S·rest and dc' = S·dc + ½(S - 1)/C0. The rasterizer then
-    // evaluates the colour per view, with no [N,3] colour pass here.
-    const int64_t used = sh_coefficients(phase.sh_degree);
-    at::Tensor dc = g.sh_dc, rest = g.sh_rest.narrow(1, 0, used - 1);
+    // The shading multiplier S > 0 folds into the SH coefficients (shaded_sh),
+    // since S·max(c, 0) = max(S·c, 0). The rasterizer then evaluates the
+    // colour per view, with no [N,3] colour pass here.
+    const int used = sh_coefficients(phase.sh_degree);
     if (shading.defined()) {
-      const at::Tensor s = shading.view({-1, 1, 1});
-      dc = dc * s + (0.5 / kShConstant) * (s - 1.0);
-      rest = rest * s;
+      out.sh = shaded_sh(g.sh_dc, g.sh_rest, shading, used);
       out.shading = shading;
+    } else {
+      out.sh = used > 1 ? at::cat({g.sh_dc, g.sh_rest.narrow(1, 0, used - 1)}, 1) : g.sh_dc;
     }
-    out.sh = used > 1 ? at::cat({dc, rest}, 1) : dc;
     out.sh_degree = phase.sh_degree;
     out.opacities = at::sigmoid(g.opacity_logit);
   }

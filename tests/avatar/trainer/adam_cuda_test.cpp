@@ -12,10 +12,9 @@ using tega::trainer::Adam;
 
 using tega::test::relative_error;
 
-TEST(AdamCuda, MatchesTheCpuInDouble) {
-  if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";
+void expect_parity(int64_t rows) {
   at::manual_seed(11);
-  const at::Tensor start = at::randn({100003, 3}, at::kDouble);
+  const at::Tensor start = at::randn({rows, 3}, at::kDouble);
   const at::Tensor scale = at::tensor({0.25, 0.25, 1.0}, at::kDouble).view({1, 3});
   at::Tensor on_cpu = start.clone().requires_grad_(true);
   at::Tensor on_gpu = start.to(at::kCUDA, at::kFloat).requires_grad_(true);
@@ -23,7 +22,7 @@ TEST(AdamCuda, MatchesTheCpuInDouble) {
   cpu.add("p", on_cpu, 1e-2, scale);
   gpu.add("p", on_gpu, 1e-2, scale.to(at::kCUDA, at::kFloat));
   for (int step = 0; step < 5; ++step) {
-    const at::Tensor weights = at::randn({100003, 3}, at::kDouble);
+    const at::Tensor weights = at::randn({rows, 3}, at::kDouble);
     on_cpu.mutable_grad() = at::Tensor();
     on_gpu.mutable_grad() = at::Tensor();
     (on_cpu * weights).sum().backward();
@@ -34,6 +33,16 @@ TEST(AdamCuda, MatchesTheCpuInDouble) {
   EXPECT_LT(relative_error(on_gpu.detach(), on_cpu.detach()), 1e-6);
   EXPECT_LT(relative_error(gpu.group("p").first_moment, cpu.group("p").first_moment), 1e-6);
   EXPECT_LT(relative_error(gpu.group("p").second_moment, cpu.group("p").second_moment), 1e-6);
+}
+
+// 100003 × 3 floats take the one-element kernel; 100000 × 3, a multiple of
+// four, the four-element one, whose quads straddle rows of the column scale.
+TEST(AdamCuda, MatchesTheCpuInDouble) {
+  if (!at::hasCUDA()) GTEST_SKIP() << "no CUDA device";
+  for (const int64_t rows : {100003, 100000}) {
+    SCOPED_TRACE(rows);
+    expect_parity(rows);
+  }
 }
 
 }  // namespace

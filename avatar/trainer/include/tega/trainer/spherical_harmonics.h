@@ -20,4 +20,11 @@ at::Tensor sh_to_rgb(const at::Tensor& sh, const at::Tensor& directions, int deg
 // [N,1,3] and sh_rest [N,K-1,3] (no [N,K,3] copy is made).
 at::Tensor sh_to_rgb(const at::Tensor& sh_dc, const at::Tensor& sh_rest, const at::Tensor& directions, int degree);
 
+// The first `used` SH coefficients [N,used,3] of Gaussians whose colour is
+// multiplied by shading [N] (> 0), for the rasterizer to evaluate:
+// S·max(c, 0) = max(S·c, 0) with dc' = S·dc + ½(S − 1)/C0 and rest' = S·rest.
+// sh_dc [N,1,3], sh_rest [N,K−1,3] with K ≥ used. One pass forward and one
+// back (a CUDA kernel on a GPU); differentiable in all three.
+at::Tensor shaded_sh(const at::Tensor& sh_dc, const at::Tensor& sh_rest, const at::Tensor& shading, int used);
+
 }  // namespace tega::trainer
