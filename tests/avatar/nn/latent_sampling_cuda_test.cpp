@@ -88,13 +88,14 @@ TEST(SampleLatentCuda, MatchesTheCpu) {
     expect_matches_cpu(64, 16, 16, 50000, sorted);
     expect_matches_cpu(64, 64, 48, 20011, sorted);
     // Channels: 32 lanes with a partial second channel per lane; 3 and 4 per
-    // lane (the latter in two chunks); groups of 8, 4 and 1 lanes.
+    // lane (the latter in two chunks); groups of 8, 4, 2 and 1 lanes.
     expect_matches_cpu(40, 16, 24, 30000, sorted);
     expect_matches_cpu(96, 16, 16, 20000, sorted);
     expect_matches_cpu(200, 8, 8, 10000, sorted);
     expect_matches_cpu(8, 32, 32, 20000, sorted);
     expect_matches_cpu(5, 7, 11, 20003, sorted);
     expect_matches_cpu(3, 16, 16, 30000, sorted);
+    expect_matches_cpu(2, 16, 16, 30000, sorted);
     expect_matches_cpu(1, 8, 8, 10001, sorted);
     // One texel (a global code: every point shares all four taps), one row.
     expect_matches_cpu(64, 1, 1, 20000, sorted);
