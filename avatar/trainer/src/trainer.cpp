@@ -110,12 +110,12 @@ class Run {
       : options_(options),
         parallel_(parallel),
         run_dir_(run_dir),
-        poisoned_iterations_(control.poisoned_iterations.begin(), control.poisoned_iterations.end()),
         device_(options.device),
         dataset_(read_dataset(dataset_dir)),
         model_((validate_dataset(dataset_), dataset_), options, device_),
         generator_(at::make_generator<at::CPUGeneratorImpl>(static_cast<uint64_t>(options.seed))),
-        profiler_(options.profile, device_) {
+        profiler_(options.profile, device_),
+        poisoned_iterations_(control.poisoned_iterations.begin(), control.poisoned_iterations.end()) {
     validate_train_options(options_);
     train_views_ = views_of(dataset_, dataset_.train.frames, dataset_.train.cameras);
     heldout_views_ = views_of(dataset_, dataset_.train.frames, dataset_.test.cameras);

@@ -8,7 +8,7 @@
 
 namespace tega {
 
-inline bool use_cuda_kernels(const at::Tensor& t, const char* op) {
+inline bool use_cuda_kernels(const at::Tensor& t, [[maybe_unused]] const char* op) {
   if (!t.is_cuda()) return false;
 #if defined(TEGA_HAVE_CUDA) && defined(TEGA_TORCH_HAS_CUDA)
   return true;
