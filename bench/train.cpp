@@ -75,7 +75,6 @@ int main(int argc, char** argv) {
     options.densify.enabled = densify;
     options.checkpoint_every = 1 << 30;
     options.log_every = 1 << 30;
-    options.loader_threads = 8;
     for (const auto& kv : overrides) {
       const auto eq = kv.find('=');
       tega::set_option(options, kv.substr(0, eq), kv.substr(eq + 1));

@@ -121,7 +121,7 @@ struct TrainOptions {
   bool momentum_per_view = false;                // on N GPUs: Adam's decays ^N (Grendel)
   double max_deformation = 0.05;                 // metres; 0 = unbounded
   int64_t log_every = 10;
-  int loader_threads = 4;
+  int loader_threads = 8;                        // a real 3072x2048 PNG: ~0.2 s of one core
   int prefetch = 8;
   int cpu_threads = 0;                           // 0: all cores
   bool profile = false;
