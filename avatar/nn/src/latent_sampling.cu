@@ -44,7 +44,7 @@ constexpr int kThreads = 256;
 constexpr int kWarp = 32;
 constexpr unsigned kFullWarp = 0xffffffffu;
 constexpr int kRun = 64;  // points per group and warp in the backward pass
-constexpr int kBatch = 4;  // points per group whose loads the backward issues together (kRun is a multiple)
+constexpr int kBatch = 4;  // points per group the backward takes at a time (kRun is a multiple)
 constexpr int kMaxChannelsPerLane = 4;
 
 // V channels of one point's sample: the taps' weighted sum at channel c.
