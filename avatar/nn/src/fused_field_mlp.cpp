@@ -12,6 +12,7 @@
 #include <torch/csrc/autograd/custom_function.h>
 
 #include "fused_field_mlp_kernels.h"
+#include "tega/core/cuda_grid.h"
 
 namespace tega::nn::fused_field {
 namespace {
@@ -148,7 +149,7 @@ class FusedFieldFunction : public torch::autograd::Function<FusedFieldFunction> 
 at::Tensor aligned(const at::Tensor& t, const at::Tensor& like) {
   if (!t.defined()) return at::empty({0}, like.options());
   const at::Tensor c = t.contiguous();
-  return reinterpret_cast<uintptr_t>(c.data_ptr()) % 16 == 0 ? c : c.clone();
+  return aligned_to_16_bytes(c.data_ptr()) ? c : c.clone();
 }
 
 }  // namespace

@@ -34,6 +34,7 @@
 #include <stdexcept>
 
 #include "tega/core/cuda_check.h"
+#include "tega/core/cuda_grid.h"
 #include "latent_sampling_kernels.h"
 #include "latent_sampling_math.h"
 
@@ -195,14 +196,12 @@ void check_int_indices(const Shape& shape) {
     throw std::invalid_argument("tega sample_latent: the CUDA kernels take at most 2^31 - 1 texels and channels");
 }
 
-bool aligned16(const void* pointer) { return reinterpret_cast<uintptr_t>(pointer) % 16 == 0; }
-
 }  // namespace
 
 void forward(const Shape& shape, const float* latent, const float* uv, float* sampled, cudaStream_t stream) {
   if (shape.points * shape.channels == 0) return;
   check_int_indices(shape);
-  const bool by_four = shape.channels % 4 == 0 && aligned16(latent) && aligned16(sampled);
+  const bool by_four = shape.channels % 4 == 0 && aligned_to_16_bytes(latent) && aligned_to_16_bytes(sampled);
   const int64_t lane_chunks = by_four ? shape.channels / 4 : shape.channels;
   int lanes = 1;
   while (lanes < kWarp && lanes < lane_chunks) lanes *= 2;

@@ -44,8 +44,6 @@ __global__ void step_kernel_by_four(int64_t quads, int64_t columns, float4* para
   }
 }
 
-bool aligned16(const void* pointer) { return reinterpret_cast<uintptr_t>(pointer) % 16 == 0; }
-
 }  // namespace
 
 template <typename T>
@@ -53,8 +51,8 @@ void step(int64_t count, int64_t columns, T* param, const T* grad, T* first_mome
           const T* column_scale, const Constants<T>& constants, cudaStream_t stream) {
   if (count == 0) return;
   if constexpr (std::is_same_v<T, float>) {
-    if (count % 4 == 0 && aligned16(param) && aligned16(grad) && aligned16(first_moment) &&
-        aligned16(second_moment)) {
+    if (count % 4 == 0 && aligned_to_16_bytes(param) && aligned_to_16_bytes(grad) &&
+        aligned_to_16_bytes(first_moment) && aligned_to_16_bytes(second_moment)) {
       step_kernel_by_four<<<grid_stride_blocks(count / 4, kThreads), kThreads, 0, stream>>>(
           count / 4, columns, reinterpret_cast<float4*>(param), reinterpret_cast<const float4*>(grad),
           reinterpret_cast<float4*>(first_moment), reinterpret_cast<float4*>(second_moment), column_scale,
