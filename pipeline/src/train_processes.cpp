@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
@@ -23,8 +24,7 @@ constexpr const char* kRank = "TEGA_TRAIN_RANK";
 constexpr const char* kWorld = "TEGA_TRAIN_WORLD";
 constexpr const char* kRendezvous = "TEGA_TRAIN_RENDEZVOUS";
 
-volatile sig_atomic_t stop_signal = 0;
-void remember_stop(int signal) { stop_signal = signal; }
+void ignore_stop(int) {}  // only interrupts wait(), which then passes the stop on
 
 // This process's command line without --gpus/--processes and their values.
 std::vector<std::string> own_arguments_without_spreading() {
@@ -61,7 +61,9 @@ int run_training_processes(int world, const std::vector<std::string>& gpus, cons
                   for (const auto& g : gpus) listed += (listed.empty() ? "" : ", ") + g;
                   return listed;
                 }()).c_str());
-  std::vector<pid_t> children;
+  // The training processes not yet waited for: only these get signals (a waited-for one's number
+  // may be reused).
+  std::vector<pid_t> running;
   const pid_t parent = ::getpid();
   for (int rank = 0; rank < world; ++rank) {
     std::vector<std::string> argv{"/proc/self/exe"};
@@ -83,30 +85,33 @@ int run_training_processes(int world, const std::vector<std::string>& gpus, cons
       ::execv("/proc/self/exe", args.data());
       ::_exit(127);
     }
-    children.push_back(pid);
+    running.push_back(pid);
   }
   // A stop for this process is passed on to the training processes, which stop together at one
   // step with a checkpoint (SIGTERM from `tega run` or a scheduler, Ctrl-C); this one waits for them.
+  // It is passed on as SIGUSR1, which they catch every time (tega/core/interrupt.h): the same stop
+  // often reaches them directly too (a terminal, Slurm and `timeout` signal the whole job), and
+  // passed on as itself it would be their second SIGTERM or SIGINT, which kills without a
+  // checkpoint. An operator's second Ctrl-C still reaches them directly and kills.
   struct sigaction on_stop {}, previous_int {}, previous_term {};
-  on_stop.sa_handler = remember_stop;  // no SA_RESTART: wait() returns to pass the signal on
+  on_stop.sa_handler = ignore_stop;  // no SA_RESTART: wait() returns to pass the stop on
   ::sigaction(SIGINT, &on_stop, &previous_int);
   ::sigaction(SIGTERM, &on_stop, &previous_term);
   int exit_status = 0;
-  for (size_t remaining = children.size(); remaining > 0;) {
+  while (!running.empty()) {
     int status = 0;
     const pid_t done = ::wait(&status);
     if (done < 0 && errno == EINTR) {
-      for (const pid_t child : children) ::kill(child, stop_signal);
+      for (const pid_t child : running) ::kill(child, SIGUSR1);
       continue;
     }
     if (done < 0) break;
-    --remaining;
+    running.erase(std::remove(running.begin(), running.end(), done), running.end());
     const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
     if (code != 0 && exit_status == 0) {
       exit_status = code;
       // The others would wait for its gradients until Gloo's timeout.
-      for (const pid_t child : children)
-        if (child != done) ::kill(child, SIGKILL);
+      for (const pid_t child : running) ::kill(child, SIGKILL);
     }
   }
   ::sigaction(SIGINT, &previous_int, nullptr);

@@ -56,8 +56,11 @@ double agreed_checksum(const std::string& output) {
   return std::regex_search(output, m, agreed) ? std::stod(m[1]) : std::nan("");
 }
 
-// SIGTERM to `tega train --processes 2` (as `tega run` or a scheduler sends it) stops both processes
-// at one step with a checkpoint; resumed, the run goes on as if it had never stopped.
+// SIGTERM to `tega train --processes 2` stops both processes at one step with a checkpoint, sent to
+// the launcher alone (`kill PID`) or to the whole process group (a terminal's Ctrl-C, `tega run`,
+// `timeout`; Slurm signals every process of a job likewise): then the training processes get it
+// directly as well as passed on, and must not take the two for an operator's second signal, which
+// kills. Resumed, the run goes on as if it had never stopped.
 TEST(CliTrain, TwoProcessesStopTogetherOnSigtermAndResumeAsIfUninterrupted) {
   if (run_tega("train --help").exit_code != 0) GTEST_SKIP() << "this tega has no train command (no libtorch)";
   TempDir tmp;
@@ -74,21 +77,29 @@ TEST(CliTrain, TwoProcessesStopTogetherOnSigtermAndResumeAsIfUninterrupted) {
   if (straight.output.find("needs libtorch's c10d") != std::string::npos) GTEST_SKIP() << "no c10d with Gloo";
   ASSERT_EQ(straight.exit_code, 0) << straight.output;
 
-  // Stopped once the run is under way (a few hundredths of a second an iteration here).
-  const std::string log = (tmp / "stopped.log").string();
-  const auto stopped = run_command("bash -c '" + train("stopped") + " >" + log + " 2>&1 & pid=$!; " +
-                                   "for i in $(seq 1200); do grep -q \" it 10/300\" " + log +
-                                   " && break; sleep 0.05; done; kill -TERM $pid; wait $pid; echo exit=$?; cat " +
-                                   log + "'");
-  EXPECT_NE(stopped.output.find("exit=130"), std::string::npos) << stopped.output;
-  std::smatch at;
-  ASSERT_TRUE(std::regex_search(stopped.output, at, std::regex(R"(interrupted after (\d+) of 300 iterations)")))
-      << stopped.output;
-  const int stopped_at = std::stoi(at[1]);
-  ASSERT_GE(stopped_at, 10);
-  ASSERT_LT(stopped_at, 100) << "the run got too far before the signal to test its resumption";
-  // Both processes stopped at that step: their parameters agree in the checkpoint they saved.
-  EXPECT_FALSE(std::isnan(agreed_checksum(stopped.output))) << stopped.output;
+  // Runs `command` in its own process group (bash's job control) and, once its log shows
+  // iteration `after`, sends SIGTERM to the launcher alone or to the group. The iteration it
+  // stopped at.
+  const auto stop = [&](const std::string& command, int after, bool whole_group) {
+    const std::string log = (tmp / "stopped.log").string();
+    const auto stopped = run_command("bash -c 'set -m; " + command + " >" + log + " 2>&1 & pid=$!; " +
+                                     "for i in $(seq 1200); do grep -q \" it " + std::to_string(after) +
+                                     "/300\" " + log + " && break; sleep 0.05; done; kill -TERM " +
+                                     (whole_group ? "-" : "") + "$pid; wait $pid; echo exit=$?; cat " + log + "'");
+    EXPECT_NE(stopped.output.find("exit=130"), std::string::npos) << stopped.output;
+    std::smatch at;
+    EXPECT_TRUE(std::regex_search(stopped.output, at, std::regex(R"(interrupted after (\d+) of 300 iterations)")))
+        << stopped.output;
+    // Both processes stopped at that step: their parameters agree in the checkpoint they saved.
+    EXPECT_FALSE(std::isnan(agreed_checksum(stopped.output))) << stopped.output;
+    return at.empty() ? -1 : std::stoi(at[1]);
+  };
+  const int launcher_stopped_at = stop(train("stopped"), 10, false);
+  ASSERT_GE(launcher_stopped_at, 10);
+  ASSERT_LT(launcher_stopped_at, 70) << "the run got too far before the signal to test its resumption";
+  const int group_stopped_at = stop(train("stopped") + " --resume", (launcher_stopped_at / 2 + 5) * 2, true);
+  ASSERT_GT(group_stopped_at, launcher_stopped_at);
+  ASSERT_LT(group_stopped_at, 100) << "the run got too far before the signal to test its resumption";
 
   const auto resumed = run_command(train("stopped") + " --resume --stop-at 100 2>&1");
   ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
