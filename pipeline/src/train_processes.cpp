@@ -24,7 +24,7 @@ constexpr const char* kRank = "TEGA_TRAIN_RANK";
 constexpr const char* kWorld = "TEGA_TRAIN_WORLD";
 constexpr const char* kRendezvous = "TEGA_TRAIN_RENDEZVOUS";
 
-void ignore_stop(int) {}  // only interrupts wait(), which then passes the stop on
+void interrupt_wait(int) {}  // wait() returns EINTR, and the loop passes the stop on
 
 // This process's command line without --gpus/--processes and their values.
 std::vector<std::string> own_arguments_without_spreading() {
@@ -94,7 +94,7 @@ int run_training_processes(int world, const std::vector<std::string>& gpus, cons
   // passed on as itself it would be their second SIGTERM or SIGINT, which kills without a
   // checkpoint. An operator's second Ctrl-C still reaches them directly and kills.
   struct sigaction on_stop {}, previous_int {}, previous_term {};
-  on_stop.sa_handler = ignore_stop;  // no SA_RESTART: wait() returns to pass the stop on
+  on_stop.sa_handler = interrupt_wait;  // no SA_RESTART: wait() returns to pass the stop on
   ::sigaction(SIGINT, &on_stop, &previous_int);
   ::sigaction(SIGTERM, &on_stop, &previous_term);
   int exit_status = 0;
