@@ -109,14 +109,16 @@ DataParallel::DataParallel(const ParallelRank& rank, const at::Device& device) :
 }
 
 // Alone, these are the identity (and without c10d no group exists beyond one process).
-void DataParallel::reduce(const std::vector<at::Tensor>& tensors, bool mean) {
+void DataParallel::reduce(const std::vector<at::Tensor>& tensors, bool mean, bool wait) {
   if (alone() || tensors.empty()) return;
 #ifdef TEGA_NCCL_GRADIENTS
   if (groups_->gpu_gradients) {
-    groups_->gpu_gradients->all_reduce(tensors, mean);
+    groups_->gpu_gradients->start_all_reduce(tensors, mean);
+    if (wait) groups_->gpu_gradients->join();
     return;
   }
 #endif
+  (void)wait;
 #ifdef TEGA_HAVE_GLOO
   std::vector<at::Tensor> flat_parts;
   for (const auto& t : tensors) flat_parts.push_back(t.reshape({-1}));
@@ -133,8 +135,15 @@ void DataParallel::reduce(const std::vector<at::Tensor>& tensors, bool mean) {
 #endif
 }
 
-void DataParallel::average(const std::vector<at::Tensor>& tensors) { reduce(tensors, true); }
-void DataParallel::sum(const std::vector<at::Tensor>& tensors) { reduce(tensors, false); }
+void DataParallel::average(const std::vector<at::Tensor>& tensors) { reduce(tensors, true, true); }
+void DataParallel::sum(const std::vector<at::Tensor>& tensors) { reduce(tensors, false, true); }
+void DataParallel::start_average(const std::vector<at::Tensor>& tensors) { reduce(tensors, true, false); }
+
+void DataParallel::join_averages() {
+#ifdef TEGA_NCCL_GRADIENTS
+  if (!alone() && groups_->gpu_gradients) groups_->gpu_gradients->join();
+#endif
+}
 
 // Through the rendezvous store, not a collective group: host numbers then never wait for a GPU
 // stream, and need neither Gloo nor NCCL. Each round, each process sets its key and reads all.

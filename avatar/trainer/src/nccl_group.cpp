@@ -1,6 +1,7 @@
 #include "nccl_group.h"
 
 #include <ATen/cuda/CUDAContext.h>
+#include <ATen/cuda/CUDAEvent.h>
 #include <c10/cuda/CUDAGuard.h>
 #include <nccl.h>
 
@@ -44,7 +45,9 @@ std::vector<uint8_t> NcclGroup::new_token() {
 }
 
 NcclGroup::NcclGroup(const std::vector<uint8_t>& token, int rank, int world, const at::Device& device)
-    : device_(at::kCUDA, device.has_index() ? device.index() : c10::cuda::current_device()) {
+    : device_(at::kCUDA, device.has_index() ? device.index() : c10::cuda::current_device()),
+      // High priority: its few blocks are scheduled ahead of the backward kernels it runs beside.
+      communication_(c10::cuda::getStreamFromPool(/*isHighPriority=*/true, device_.index())) {
   ncclUniqueId id;
   if (token.size() != sizeof(id))
     throw Error("data-parallel training: the NCCL token read from the rendezvous has " + std::to_string(token.size()) +
@@ -59,25 +62,45 @@ NcclGroup::~NcclGroup() {
 }
 
 void NcclGroup::all_reduce(const std::vector<at::Tensor>& tensors, bool mean) {
+  start_all_reduce(tensors, mean);
+  join();
+}
+
+void NcclGroup::start_all_reduce(const std::vector<at::Tensor>& tensors, bool mean) {
   // Checked before the group call opens: a throw inside it would leave it open.
-  std::vector<at::Tensor> reduced;
   for (const at::Tensor& tensor : tensors) {
     if (tensor.device() != device_)
       throw Error("data-parallel training: a tensor on " + tensor.device().str() + " given to the NCCL group of " +
                   device_.str());
     nccl_type(tensor.scalar_type());
-    reduced.push_back(tensor.contiguous());  // the tensor itself where it is contiguous
   }
   const c10::cuda::CUDAGuard guard(device_);
-  const cudaStream_t stream = at::cuda::getCurrentCUDAStream(device_.index()).stream();
-  check(ncclGroupStart(), "ncclGroupStart", communicator_);
-  for (const at::Tensor& r : reduced)
-    check(ncclAllReduce(r.data_ptr(), r.data_ptr(), static_cast<size_t>(r.numel()), nccl_type(r.scalar_type()),
-                        mean ? ncclAvg : ncclSum, communicator_, stream),
-          "ncclAllReduce", communicator_);
-  check(ncclGroupEnd(), "ncclGroupEnd", communicator_);
-  for (size_t i = 0; i < tensors.size(); ++i)
-    if (!reduced[i].is_same(tensors[i])) tensors[i].copy_(reduced[i]);
+  std::vector<at::Tensor> reduced;
+  for (const at::Tensor& tensor : tensors) reduced.push_back(tensor.contiguous());  // itself where contiguous
+  at::cuda::CUDAEvent written;
+  written.record(c10::cuda::getCurrentCUDAStream(device_.index()));
+  written.block(communication_);
+  {
+    const c10::cuda::CUDAStreamGuard on_communication(communication_);
+    check(ncclGroupStart(), "ncclGroupStart", communicator_);
+    for (const at::Tensor& r : reduced)
+      check(ncclAllReduce(r.data_ptr(), r.data_ptr(), static_cast<size_t>(r.numel()), nccl_type(r.scalar_type()),
+                          mean ? ncclAvg : ncclSum, communicator_, communication_.stream()),
+            "ncclAllReduce", communicator_);
+    check(ncclGroupEnd(), "ncclGroupEnd", communicator_);
+    for (size_t i = 0; i < tensors.size(); ++i) {
+      if (!reduced[i].is_same(tensors[i])) tensors[i].copy_(reduced[i]);
+      // Their memory is not reused by the caller's stream before this stream is done with it.
+      reduced[i].record_stream(communication_);
+      tensors[i].record_stream(communication_);
+    }
+  }
+}
+
+void NcclGroup::join() {
+  at::cuda::CUDAEvent reduced;
+  reduced.record(communication_);
+  reduced.block(c10::cuda::getCurrentCUDAStream(device_.index()));
 }
 
 }  // namespace tega::trainer

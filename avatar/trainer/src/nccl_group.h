@@ -1,10 +1,12 @@
 #pragma once
 // The gradients' all-reduce of a run trained on several GPUs (data_parallel.h), through NCCL's own
-// C API on each tensor's current CUDA stream. c10d's NCCL group would want them flattened into one
-// buffer and copied back (about 1 GB each way a step at 4M Gaussians); one NCCL group call reduces
-// each gradient in place, and averages in NCCL itself (ncclAvg).
+// C API. c10d's NCCL group would want them flattened into one buffer and copied back (about 1 GB
+// each way a step at 4M Gaussians); one NCCL group call reduces each gradient in place, and
+// averages in NCCL itself (ncclAvg). Every all-reduce runs on the group's own stream, after the
+// work queued so far on the caller's: those started during backward run beside its later kernels.
 
 #include <ATen/ATen.h>
+#include <c10/cuda/CUDAStream.h>
 
 #include <cstdint>
 #include <vector>
@@ -24,14 +26,19 @@ class NcclGroup {
   NcclGroup(const NcclGroup&) = delete;
   NcclGroup& operator=(const NcclGroup&) = delete;
 
-  // In place, each tensor (on this process's GPU) becomes its sum or mean over the processes. Queued
-  // on the current stream, in one NCCL group call, without a copy for contiguous tensors and without
-  // waiting on the host: later work on the stream sees the result.
+  // In place, each tensor (on this process's GPU) becomes its sum or mean over the processes: one
+  // NCCL group call, without a copy for contiguous tensors and without waiting on the host. Later
+  // work on the current stream sees the result.
   void all_reduce(const std::vector<at::Tensor>& tensors, bool mean);
+  // The same, but the current stream does not wait for the result: it sees it after join().
+  void start_all_reduce(const std::vector<at::Tensor>& tensors, bool mean);
+  // The current stream waits for every all-reduce started so far.
+  void join();
 
  private:
   ncclComm* communicator_ = nullptr;
   at::Device device_;
+  c10::cuda::CUDAStream communication_;
 };
 
 }  // namespace tega::trainer

@@ -31,6 +31,7 @@
 #include "tega/trainer/checkpoint.h"
 #include "tega/trainer/data_parallel.h"
 #include "tega/trainer/densifier.h"
+#include "tega/trainer/gradient_average.h"
 #include "tega/trainer/render.h"
 #include "tega/trainer/schedules.h"
 #include "tega/trainer/step_profiler.h"
@@ -325,13 +326,11 @@ class Run {
 
     profiler_.section("backward");
     adam_.zero_grad();
+    if (!parallel_.alone()) gradient_average_.arm(gradient_buckets());
     loss.backward();
     if (!parallel_.alone()) {
       RECORD_FUNCTION("tega::gradient_all_reduce", std::vector<c10::IValue>());
-      std::vector<at::Tensor> gradients;
-      for (const auto& g : adam_.groups())
-        if (g.parameter.grad().defined()) gradients.push_back(g.parameter.grad());
-      parallel_.average(gradients);
+      gradient_average_.finish();
     }
     // A NaN/Inf is reported one step late: the step that made it has updated
     // the parameters by then, but nothing is saved before its check (the loop
@@ -359,6 +358,22 @@ class Run {
 
     profiler_.section("densification");
     densify_if_due(camera);
+  }
+
+  // The parameters in the order backward finishes their gradients, for the average started during
+  // it (gradient_average.h): first the Gaussians' tensors the rasterizer's backward reaches at once
+  // (sh_rest last: the first SH degrees leave it without a gradient), then in one bucket uvd, which
+  // the fields read, and the fields.
+  std::vector<std::vector<at::Tensor>> gradient_buckets() {
+    static const std::vector<std::string> kReachedFirst{"opacity_logit", "sh_dc", "rotation", "log_scale", "sh_rest"};
+    std::vector<std::vector<at::Tensor>> buckets;
+    for (const std::string& name : kReachedFirst) buckets.push_back({adam_.group(name).parameter});
+    std::vector<at::Tensor> rest;
+    for (const auto& g : adam_.groups())
+      if (std::find(kReachedFirst.begin(), kReachedFirst.end(), g.name) == kReachedFirst.end())
+        rest.push_back(g.parameter);
+    buckets.push_back(std::move(rest));
+    return buckets;
   }
 
   // The weighted Jacobian smoothness loss on random uvd samples, or undefined
@@ -632,6 +647,7 @@ class Run {
   Dataset dataset_;
   AvatarModel model_;
   Adam adam_;
+  GradientAverage gradient_average_{parallel_};
   std::vector<std::string> network_groups_;
   at::Generator generator_;
   splat::MeanGradientStats stats_;

@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "tega/trainer/data_parallel.h"
+#include "tega/trainer/gradient_average.h"
 #include "test_support.h"
 
 namespace tega::trainer {
@@ -49,6 +50,56 @@ TEST(DataParallelCuda, AveragesAndSumsOverTwoGpusInPlace) {
     EXPECT_TRUE(at::equal(strided[rank].cpu(), (at::arange(12, at::kFloat) * 2).view({3, 4}).t())) << strided[rank];
     EXPECT_TRUE(at::equal(counts[rank].cpu(), at::full({6}, 7.0, at::kDouble)));
     EXPECT_EQ(host[rank], 3.0);
+  }
+}
+
+// The average started during backward (gradient_average.h): on GPUs it runs on NCCL's own stream
+// beside backward's later kernels, and the step's stream sees it after finish().
+TEST(DataParallelCuda, GradientAverageStartedDuringBackwardReachesTheStepsStream) {
+  if (!at::hasCUDA() || at::getNumGPUs() < 2) GTEST_SKIP() << "fewer than two GPUs";
+  if (!DataParallel::available(at::kCUDA)) GTEST_SKIP() << "this build has no NCCL";
+  test::TempDir dir;
+  constexpr int kWorld = 2;
+  constexpr int64_t kEarly = 8 << 20;  // a Gaussians' tensor's worth: its all-reduce takes a while
+  at::Tensor early[kWorld], late[kWorld];
+  int started[kWorld] = {};
+  std::string failures[kWorld];
+  std::vector<std::thread> processes;
+  for (int rank = 0; rank < kWorld; ++rank) {
+    processes.emplace_back([&, rank] {
+      try {
+        const at::Device gpu(at::kCUDA, rank);
+        DataParallel parallel({rank, kWorld, dir / "rendezvous"}, gpu);
+        GradientAverage average(parallel);
+        const auto on_gpu = at::TensorOptions().device(gpu);
+        const at::Tensor e = at::ones({kEarly}, on_gpu).requires_grad_(), l = at::ones({64, 64}, on_gpu).requires_grad_();
+        const double r = rank + 1;
+        for (int step = 0; step < 3; ++step) {
+          e.mutable_grad() = at::Tensor();
+          l.mutable_grad() = at::Tensor();
+          // `late`'s branch, made first, is reached last, after a few products' worth of backward.
+          at::Tensor late_branch = l * r;
+          for (int i = 0; i < 8; ++i) late_branch = late_branch.matmul(at::eye(64, on_gpu));
+          const at::Tensor early_term = (e * (2 * r)).sum();
+          const at::Tensor loss = late_branch.sum() + early_term;
+          average.arm({{e}, {l}});
+          loss.backward();
+          average.finish();
+          started[rank] = average.started_during_backward();
+        }
+        early[rank] = e.grad().cpu();  // on the step's stream
+        late[rank] = l.grad().cpu();
+      } catch (const std::exception& ex) {
+        failures[rank] = ex.what();
+      }
+    });
+  }
+  for (auto& p : processes) p.join();
+  for (int rank = 0; rank < kWorld; ++rank) {
+    ASSERT_EQ(failures[rank], "") << "GPU " << rank;
+    EXPECT_TRUE(at::equal(early[rank], at::full({kEarly}, 3.0f)));
+    EXPECT_TRUE(at::equal(late[rank], at::full({64, 64}, 1.5f))) << late[rank];
+    EXPECT_EQ(started[rank], 2);
   }
 }
 

@@ -39,13 +39,19 @@ class DataParallel {
   // collective over the tensors flattened together, so every process must pass the same shapes.
   void average(const std::vector<at::Tensor>& tensors);
   void sum(const std::vector<at::Tensor>& tensors);
+  // average(), except that on GPUs the current stream sees the result only after join_averages():
+  // what backward starts for the gradients it has finished (gradient_average.h), its later
+  // kernels running beside the all-reduce. On the CPU it is average() (Gloo waits).
+  void start_average(const std::vector<at::Tensor>& tensors);
+  // The current stream waits for every average started.
+  void join_averages();
   // On the host: the processes' sums of `values`.
   std::vector<double> host_sum(const std::vector<double>& values);
   void barrier();
 
  private:
   struct Groups;
-  void reduce(const std::vector<at::Tensor>& tensors, bool mean);
+  void reduce(const std::vector<at::Tensor>& tensors, bool mean, bool wait);
 
   int rank_ = 0, world_ = 1;
   std::unique_ptr<Groups> groups_;
