@@ -2,10 +2,9 @@
 
 #include <gtest/gtest.h>
 
-#include <thread>
-
 #include "tega/core/error.h"
 #include "test_support.h"
+#include "two_processes.h"
 
 namespace tega::trainer {
 namespace {
@@ -14,31 +13,22 @@ namespace {
 TEST(DataParallel, AveragesAndSumsOverTheProcessesAndAgreesOnHostNumbers) {
   if (!DataParallel::available(at::kCPU)) GTEST_SKIP() << "this build's libtorch has no c10d with Gloo";
   test::TempDir dir;
-  constexpr int kWorld = 2;
+  constexpr int kWorld = test::kTwoProcesses;
   at::Tensor gradient[kWorld], other[kWorld], counts[kWorld];
   std::vector<double> host[kWorld], rounds[kWorld];
-  std::string failures[kWorld];
-  std::vector<std::thread> processes;
-  for (int rank = 0; rank < kWorld; ++rank) {
-    processes.emplace_back([&, rank] {
-      try {
-        DataParallel parallel({rank, kWorld, dir / "rendezvous"}, at::kCPU);
-        gradient[rank] = at::full({3, 4}, rank + 1.0f);  // 1 and 2: mean 1.5
-        other[rank] = at::arange(5, at::kFloat) * (rank == 0 ? 1 : 3);  // mean 2 i
-        counts[rank] = at::full({6}, rank == 0 ? 2.0f : 5.0f);
-        parallel.average({gradient[rank], other[rank]});
-        parallel.sum({counts[rank]});
-        host[rank] = parallel.host_sum({rank == 0 ? 0.25 : 0.5, 1.0});
-        // Many rounds, as a run has (one a step): each its own sums, old keys dropped as they go.
-        for (int round = 0; round < 50; ++round)
-          rounds[rank].push_back(parallel.host_sum({double(round * (rank + 1))})[0]);
-        parallel.barrier();
-      } catch (const std::exception& e) {
-        failures[rank] = e.what();
-      }
-    });
-  }
-  for (auto& p : processes) p.join();
+  const auto failures = test::as_two_processes([&](int rank) {
+    DataParallel parallel({rank, kWorld, dir / "rendezvous"}, at::kCPU);
+    gradient[rank] = at::full({3, 4}, rank + 1.0f);  // 1 and 2: mean 1.5
+    other[rank] = at::arange(5, at::kFloat) * (rank == 0 ? 1 : 3);  // mean 2 i
+    counts[rank] = at::full({6}, rank == 0 ? 2.0f : 5.0f);
+    parallel.average({gradient[rank], other[rank]});
+    parallel.sum({counts[rank]});
+    host[rank] = parallel.host_sum({rank == 0 ? 0.25 : 0.5, 1.0});
+    // Many rounds, as a run has (one a step): each its own sums, old keys dropped as they go.
+    for (int round = 0; round < 50; ++round)
+      rounds[rank].push_back(parallel.host_sum({double(round * (rank + 1))})[0]);
+    parallel.barrier();
+  });
   for (int rank = 0; rank < kWorld; ++rank) {
     ASSERT_EQ(failures[rank], "") << "process " << rank;
     for (int round = 0; round < 50; ++round) EXPECT_EQ(rounds[rank][round], 3.0 * round);

@@ -5,14 +5,11 @@
 
 #include <gtest/gtest.h>
 
-#include <thread>
-
 #include "test_support.h"
+#include "two_processes.h"
 
 namespace tega::trainer {
 namespace {
-
-constexpr int kWorld = 2;
 
 at::Tensor parameter(int64_t size) { return at::ones({size}).requires_grad_(); }
 
@@ -22,60 +19,51 @@ TEST(GradientAverage, StartsEachBucketInBackwardOnceItAndTheBucketsBeforeItHaveT
   struct Seen {
     at::Tensor early_when_late_reached, early, late, unused, densified, densified_when_late_reached, dropped;
     int started_first = -1, started_second = -1;
-    std::string failure;
-  } seen[kWorld];
-  std::vector<std::thread> processes;
-  for (int rank = 0; rank < kWorld; ++rank) {
-    processes.emplace_back([&, rank] {
-      Seen& s = seen[rank];
-      try {
-        DataParallel parallel({rank, kWorld, dir / "rendezvous"}, at::kCPU);
-        GradientAverage average(parallel);
-        const double r = rank + 1;  // each process its own gradients: means 3 (early) and 1.5 (late)
-        at::Tensor early = parameter(4), late = parameter(3), unused = parameter(2);
+  } seen[test::kTwoProcesses];
+  const auto failures = test::as_two_processes([&](int rank) {
+    Seen& s = seen[rank];
+    DataParallel parallel({rank, test::kTwoProcesses, dir / "rendezvous"}, at::kCPU);
+    GradientAverage average(parallel);
+    const double r = rank + 1;  // each process its own gradients: means 3 (early) and 1.5 (late)
+    at::Tensor early = parameter(4), late = parameter(3), unused = parameter(2);
 
-        // Backward runs the nodes made last first: `late`'s branch, made first, is reached last.
-        const at::Tensor late_branch = late * r;
-        late_branch.register_hook([&](const at::Tensor&) {
-          if (early.grad().defined()) s.early_when_late_reached = early.grad().clone();
-        });
-        const at::Tensor early_term = (early * (2 * r)).sum();
-        const at::Tensor loss = late_branch.sum() + early_term;
-        average.arm({{early}, {late}, {unused}});
-        loss.backward();
-        average.finish();
-        s.started_first = average.started_during_backward();
-        s.early = early.grad();
-        s.late = late.grad();
-        s.unused = unused.grad();
-
-        // Densification: `early` replaced by a larger tensor, which needs hooks of its own. The
-        // old one, trained on here but in no bucket, is reached first.
-        const at::Tensor densified = parameter(6), dropped = early;
-        dropped.mutable_grad() = at::Tensor();
-        late.mutable_grad() = at::Tensor();
-        const at::Tensor late_again = late * r;
-        late_again.register_hook([&](const at::Tensor&) {
-          if (densified.grad().defined()) s.densified_when_late_reached = densified.grad().clone();
-        });
-        const at::Tensor densified_term = (densified * (2 * r)).sum();
-        const at::Tensor dropped_term = (dropped * r).sum();
-        const at::Tensor next_loss = late_again.sum() + densified_term + dropped_term;
-        average.arm({{densified}, {late}});
-        next_loss.backward();
-        average.finish();
-        s.started_second = average.started_during_backward();
-        s.densified = densified.grad();
-        s.dropped = dropped.grad();
-      } catch (const std::exception& e) {
-        s.failure = e.what();
-      }
+    // Backward runs the nodes made last first: `late`'s branch, made first, is reached last.
+    const at::Tensor late_branch = late * r;
+    late_branch.register_hook([&](const at::Tensor&) {
+      if (early.grad().defined()) s.early_when_late_reached = early.grad().clone();
     });
-  }
-  for (auto& p : processes) p.join();
-  for (int rank = 0; rank < kWorld; ++rank) {
+    const at::Tensor early_term = (early * (2 * r)).sum();
+    const at::Tensor loss = late_branch.sum() + early_term;
+    average.arm({{early}, {late}, {unused}});
+    loss.backward();
+    average.finish();
+    s.started_first = average.started_during_backward();
+    s.early = early.grad();
+    s.late = late.grad();
+    s.unused = unused.grad();
+
+    // Densification: `early` replaced by a larger tensor, which needs hooks of its own. The
+    // old one, trained on here but in no bucket, is reached first.
+    const at::Tensor densified = parameter(6), dropped = early;
+    dropped.mutable_grad() = at::Tensor();
+    late.mutable_grad() = at::Tensor();
+    const at::Tensor late_again = late * r;
+    late_again.register_hook([&](const at::Tensor&) {
+      if (densified.grad().defined()) s.densified_when_late_reached = densified.grad().clone();
+    });
+    const at::Tensor densified_term = (densified * (2 * r)).sum();
+    const at::Tensor dropped_term = (dropped * r).sum();
+    const at::Tensor next_loss = late_again.sum() + densified_term + dropped_term;
+    average.arm({{densified}, {late}});
+    next_loss.backward();
+    average.finish();
+    s.started_second = average.started_during_backward();
+    s.densified = densified.grad();
+    s.dropped = dropped.grad();
+  });
+  for (int rank = 0; rank < test::kTwoProcesses; ++rank) {
     const Seen& s = seen[rank];
-    ASSERT_EQ(s.failure, "") << "process " << rank;
+    ASSERT_EQ(failures[rank], "") << "process " << rank;
     ASSERT_TRUE(s.early_when_late_reached.defined()) << "backward reached `late` before `early`'s gradient";
     EXPECT_TRUE(at::equal(s.early_when_late_reached, at::full({4}, 3.0f))) << "not averaged during backward";
     EXPECT_TRUE(at::equal(s.early, at::full({4}, 3.0f))) << s.early;
