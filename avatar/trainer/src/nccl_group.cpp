@@ -61,11 +61,6 @@ NcclGroup::~NcclGroup() {
   if (communicator_) ncclCommDestroy(communicator_);
 }
 
-void NcclGroup::all_reduce(const std::vector<at::Tensor>& tensors, bool mean) {
-  start_all_reduce(tensors, mean);
-  join();
-}
-
 void NcclGroup::start_all_reduce(const std::vector<at::Tensor>& tensors, bool mean) {
   // Checked before the group call opens: a throw inside it would leave it open.
   for (const at::Tensor& tensor : tensors) {

@@ -27,10 +27,9 @@ class NcclGroup {
   NcclGroup& operator=(const NcclGroup&) = delete;
 
   // In place, each tensor (on this process's GPU) becomes its sum or mean over the processes: one
-  // NCCL group call, without a copy for contiguous tensors and without waiting on the host. Later
-  // work on the current stream sees the result.
-  void all_reduce(const std::vector<at::Tensor>& tensors, bool mean);
-  // The same, but the current stream does not wait for the result: it sees it after join().
+  // NCCL group call, without a copy for contiguous tensors and without waiting on the host. It
+  // follows the work queued on the current stream so far, and that stream sees the result after
+  // join().
   void start_all_reduce(const std::vector<at::Tensor>& tensors, bool mean);
   // The current stream waits for every all-reduce started so far.
   void join();
