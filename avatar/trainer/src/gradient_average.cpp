@@ -112,6 +112,14 @@ void GradientAverage::finish() {
   parallel_.join_averages();
 }
 
+void GradientAverage::forget() {
+  State& s = *state_;
+  const std::lock_guard<std::mutex> lock(s.mutex);
+  if (s.armed) throw Error("the gradients' average: forget() between arm() and finish()");
+  s.detach_hooks();
+  s.buckets.clear();
+}
+
 int GradientAverage::started_during_backward() const { return state_->started_during_backward; }
 
 }  // namespace tega::trainer

@@ -1,7 +1,6 @@
 #include "nccl_group.h"
 
 #include <ATen/cuda/CUDAContext.h>
-#include <ATen/cuda/CUDAEvent.h>
 #include <c10/cuda/CUDAGuard.h>
 #include <nccl.h>
 
@@ -72,9 +71,8 @@ void NcclGroup::start_all_reduce(const std::vector<at::Tensor>& tensors, bool me
   const c10::cuda::CUDAGuard guard(device_);
   std::vector<at::Tensor> reduced;
   for (const at::Tensor& tensor : tensors) reduced.push_back(tensor.contiguous());  // itself where contiguous
-  at::cuda::CUDAEvent written;
-  written.record(c10::cuda::getCurrentCUDAStream(device_.index()));
-  written.block(communication_);
+  queued_.record(c10::cuda::getCurrentCUDAStream(device_.index()));
+  queued_.block(communication_);
   {
     const c10::cuda::CUDAStreamGuard on_communication(communication_);
     check(ncclGroupStart(), "ncclGroupStart", communicator_);
@@ -93,9 +91,8 @@ void NcclGroup::start_all_reduce(const std::vector<at::Tensor>& tensors, bool me
 }
 
 void NcclGroup::join() {
-  at::cuda::CUDAEvent reduced;
-  reduced.record(communication_);
-  reduced.block(c10::cuda::getCurrentCUDAStream(device_.index()));
+  reduced_.record(communication_);
+  reduced_.block(c10::cuda::getCurrentCUDAStream(device_.index()));
 }
 
 }  // namespace tega::trainer

@@ -6,6 +6,7 @@
 // work queued so far on the caller's: those started during backward run beside its later kernels.
 
 #include <ATen/ATen.h>
+#include <ATen/cuda/CUDAEvent.h>
 #include <c10/cuda/CUDAStream.h>
 
 #include <cstdint>
@@ -38,6 +39,9 @@ class NcclGroup {
   ncclComm* communicator_ = nullptr;
   at::Device device_;
   c10::cuda::CUDAStream communication_;
+  // Recorded again at each call (a stream's wait takes the event as it is then): the work queued on
+  // the caller's stream before an all-reduce, and every all-reduce started before a join.
+  at::cuda::CUDAEvent queued_, reduced_;
 };
 
 }  // namespace tega::trainer

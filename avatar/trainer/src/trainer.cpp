@@ -515,6 +515,7 @@ class Run {
       const double pixels_per_ndc = 0.5 * std::max(camera.width, camera.height);
       parallel_.sum({stats_.grad_norm_sum, stats_.visible_count});  // every process's views count
       DensifyStats stats{stats_.grad_norm_sum * pixels_per_ndc, stats_.visible_count, max_world_std_};
+      gradient_average_.forget();
       const DensifyResult r = densify(model_.gaussians, adam_, stats, d, model_.lookup(),
                                       options_.network.texture_size, generator_);
       logging::debug("densify at %lld: cloned %lld, split %lld, pruned %lld -> %lld Gaussians",
@@ -598,6 +599,7 @@ class Run {
 
   void restore(const Checkpoint& c, const fs::path& file) {
     check_uv_layout(c, file, model_, dataset_.template_mesh, options_.binding == "rigged");
+    gradient_average_.forget();
     model_.gaussians = gaussians_from_tensors(c.tensors, device_, options_.binding == "rigged",
                                                model_.lookup().num_triangles());
     nn::load_module_tensors(*model_.network, c.tensors, file, "network.");

@@ -79,6 +79,46 @@ TEST(GradientAverage, StartsEachBucketInBackwardOnceItAndTheBucketsBeforeItHaveT
   }
 }
 
+TEST(GradientAverage, ForgottenItFreesTheParametersItHookedAndHooksTheirSuccessorsAnew) {
+  if (!DataParallel::available(at::kCPU)) GTEST_SKIP() << "this build's libtorch has no c10d with Gloo";
+  test::TempDir dir;
+  struct Seen {
+    bool held_after_replacement = false, held_after_forget = true;
+    at::Tensor successor;
+    int started = -1;
+  } seen[test::kTwoProcesses];
+  const auto failures = test::as_two_processes([&](int rank) {
+    Seen& s = seen[rank];
+    DataParallel parallel({rank, test::kTwoProcesses, dir / "rendezvous"}, at::kCPU);
+    GradientAverage average(parallel);
+    const double r = rank + 1;
+    at::Tensor replaced = parameter(4);
+    const c10::weak_intrusive_ptr<c10::TensorImpl, c10::UndefinedTensorImpl> weak(replaced.getIntrusivePtr());
+    average.arm({{replaced}});
+    (replaced * r).sum().backward();
+    average.finish();
+
+    replaced = parameter(5);  // as densification replaces a parameter
+    s.held_after_replacement = !weak.expired();
+    average.forget();
+    s.held_after_forget = !weak.expired();
+
+    average.arm({{replaced}});
+    (replaced * (2 * r)).sum().backward();
+    average.finish();
+    s.successor = replaced.grad();
+    s.started = average.started_during_backward();
+  });
+  for (int rank = 0; rank < test::kTwoProcesses; ++rank) {
+    const Seen& s = seen[rank];
+    ASSERT_EQ(failures[rank], "") << "process " << rank;
+    EXPECT_TRUE(s.held_after_replacement) << "the hooks no longer hold their parameter: forget() has nothing to do";
+    EXPECT_FALSE(s.held_after_forget) << "the replaced parameter outlived forget()";
+    EXPECT_TRUE(at::equal(s.successor, at::full({5}, 3.0f))) << s.successor;
+    EXPECT_EQ(s.started, 1) << "the successor's bucket was not started by its own hook";
+  }
+}
+
 TEST(GradientAverage, AloneItLeavesTheGradientsAsBackwardMadeThem) {
   DataParallel alone;
   GradientAverage average(alone);
