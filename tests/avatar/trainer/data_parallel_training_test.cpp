@@ -1,7 +1,8 @@
-// Training shared by two processes (data_parallel.h) on the CPU: a NaN in one process's step rolls
-// both back, as on one GPU; momentum_per_view sets Adam's decays for two views a step. The test
-// runs its own executable twice as the two processes.
+// Training shared by two processes (data_parallel.h) on the CPU and on two GPUs: a NaN in one
+// process's step rolls both back, as on one GPU; momentum_per_view sets Adam's decays for two views
+// a step. The test runs its own executable twice as the two processes.
 
+#include <ATen/ATen.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <spawn.h>
@@ -10,6 +11,7 @@
 
 #include <chrono>
 #include <cstdlib>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <utility>
@@ -29,14 +31,17 @@ namespace {
 constexpr const char* kRankVariable = "TEGA_TEST_TRAINING_RANK";
 constexpr const char* kFolderVariable = "TEGA_TEST_TRAINING_FOLDER";
 constexpr const char* kPhaseVariable = "TEGA_TEST_TRAINING_PHASE";
+constexpr const char* kDeviceVariable = "TEGA_TEST_TRAINING_DEVICE";
 
 // One of the two processes of a phase, in FOLDER: "rolled" trains FOLDER/rolled with the second
 // process's loss of iteration 5 made NaN; "reference-start" trains FOLDER/reference to iteration 3
 // and "reference-rest" resumes it with every learning rate halved, what a roll-back from 5 to
 // the checkpoint of 3 does; "per-view" and "per-step" take one step into FOLDER/<phase>, with
-// and without momentum_per_view.
-void train_as_one_of_two(int rank, const std::filesystem::path& folder, const std::string& phase) {
+// and without momentum_per_view. On `device`: cpu, or cuda (the process's own GPU).
+void train_as_one_of_two(int rank, const std::filesystem::path& folder, const std::string& phase,
+                         const std::string& device) {
   TrainOptions options = test::tiny_options();
+  options.device = device;
   options.checkpoint_every = 3;
   RunControl control;
   control.parallel = {rank, 2, folder / (phase + ".rendezvous")};
@@ -63,16 +68,32 @@ void train_as_one_of_two(int rank, const std::filesystem::path& folder, const st
 bool trained_as_one_of_two() {
   const char* rank = std::getenv(kRankVariable);
   if (!rank) return false;
-  train_as_one_of_two(std::atoi(rank), std::getenv(kFolderVariable), std::getenv(kPhaseVariable));
+  train_as_one_of_two(std::atoi(rank), std::getenv(kFolderVariable), std::getenv(kPhaseVariable),
+                      std::getenv(kDeviceVariable));
   return true;
 }
 
+// The GPU a process of rank `rank` trains on, as `tega train --gpus 0,1` gives it: the rank-th of
+// the GPUs this process sees.
+std::string visible_gpu(int rank) {
+  const char* visible = std::getenv("CUDA_VISIBLE_DEVICES");
+  if (!visible) return std::to_string(rank);
+  std::vector<std::string> gpus;
+  std::istringstream list(visible);
+  for (std::string gpu; std::getline(list, gpu, ',');) gpus.push_back(gpu);
+  return rank < static_cast<int>(gpus.size()) ? gpus[rank] : std::to_string(rank);
+}
+
 // Starts this test in another process, as `rank` of `phase`'s two.
-pid_t start_process(int rank, const std::filesystem::path& folder, const std::string& phase) {
+pid_t start_process(int rank, const std::filesystem::path& folder, const std::string& phase,
+                    const std::string& device) {
   std::vector<std::string> environment{std::string(kRankVariable) + "=" + std::to_string(rank),
                                        std::string(kFolderVariable) + "=" + folder.string(),
-                                       std::string(kPhaseVariable) + "=" + phase};
-  for (char** e = environ; *e; ++e) environment.emplace_back(*e);
+                                       std::string(kPhaseVariable) + "=" + phase,
+                                       std::string(kDeviceVariable) + "=" + device};
+  if (device == "cuda") environment.push_back("CUDA_VISIBLE_DEVICES=" + visible_gpu(rank));
+  for (char** e = environ; *e; ++e)
+    if (device != "cuda" || std::string(*e).rfind("CUDA_VISIBLE_DEVICES=", 0) != 0) environment.emplace_back(*e);
   std::vector<char*> envp;
   for (auto& e : environment) envp.push_back(e.data());
   envp.push_back(nullptr);
@@ -101,8 +122,9 @@ int wait_for(pid_t pid, std::chrono::seconds patience) {
 }
 
 // Both processes of `phase` to their end; false if either failed.
-bool train_two_processes(const std::filesystem::path& folder, const std::string& phase) {
-  const pid_t first = start_process(0, folder, phase), second = start_process(1, folder, phase);
+bool train_two_processes(const std::filesystem::path& folder, const std::string& phase,
+                         const std::string& device = "cpu") {
+  const pid_t first = start_process(0, folder, phase, device), second = start_process(1, folder, phase, device);
   // Patience for a process that would wait for the other's gradients forever.
   const int first_status = first > 0 ? wait_for(first, std::chrono::seconds(300)) : -1;
   const int second_status = second > 0 ? wait_for(second, std::chrono::seconds(300)) : -1;
@@ -127,6 +149,23 @@ TEST(DataParallelTraining, ANanInOneProcessRollsEveryProcessBack) {
   ASSERT_TRUE(train_two_processes(tmp.path(), "reference-start"));
   ASSERT_TRUE(train_two_processes(tmp.path(), "reference-rest"));
   test::expect_same_parameters(tmp / "reference", tmp / "rolled");
+}
+
+// The same on two GPUs, through NCCL and the gradients' average started during backward (whose
+// hooks let go of the rolled-back parameters and take the checkpoint's). Two GPU runs differ in
+// their last bits (the rasterizer's backward adds with atomics) and Adam's first steps magnify
+// that, so no reference run is compared: both processes finishing, their parameters equal at the
+// end (the run checks), after one roll-back to the same step is the check.
+TEST(DataParallelTrainingCuda, ANanInOneGpusProcessRollsBothGpusBack) {
+  if (trained_as_one_of_two()) return;  // first: a process of the pair sees one GPU
+  if (!at::hasCUDA() || at::getNumGPUs() < 2) GTEST_SKIP() << "fewer than two GPUs";
+  if (!DataParallel::available(at::kCUDA)) GTEST_SKIP() << "this build has no NCCL";
+  test::TempDir tmp;
+  test::write_tiny_dataset(tmp / "data", /*eyeball=*/false);
+  ASSERT_TRUE(train_two_processes(tmp.path(), "rolled", "cuda"));
+  const Checkpoint last = read_checkpoint(tmp / "rolled/checkpoint.safetensors");
+  EXPECT_EQ(last.iteration(), 6);
+  EXPECT_EQ(last.tensors.at("trainer.learning_rate_scale").item<double>(), 0.5);
 }
 
 // The first step's moments hold (1 - β1) g and (1 - β2) g² of each gradient g, so m² / v is
