@@ -213,7 +213,7 @@ TEST(TerminatedTraining, AStoppedTrainShardSavesTheStepItWasAtAndResumesThere) {
   ASSERT_GT(run, 0);
   // Stopped once the shard's log shows a quarter of the steps: a moment in the run's training
   // itself, however long `tega run`'s start takes on a loaded machine (a delay from the first
-  // checkpoint, proportioned to the reference's time, once fell after the last step).
+  // checkpoint, proportioned to the reference run's time, failed once on a loaded machine).
   const std::string quarter = " it " + std::to_string(kIterations / 4) + "/";
   const auto launched = Clock::now();
   while ((!fs::exists(log) || read_text_file(log).find(quarter) == std::string::npos) &&
