@@ -158,7 +158,8 @@ struct TrainOptions {
     v("momentum_per_view", momentum_per_view,
       "On several GPUs (N views a step): raise Adam's moment decays (0.9, 0.999) to the N-th power, so that the "
       "moments forget at the same rate per view as on one GPU, as Grendel does beside its sqrt(N) learning rates. "
-      "false: one GPU's decays a step. No effect on one GPU.");
+      "false: one GPU's decays a step. No effect on one GPU. On two GPUs it gained nothing over the learning rates' "
+      "rule alone and made seeds differ more (docs/training.md).");
     v("max_deformation", max_deformation,
       "Metres: a step whose deformation field moves a Gaussian further than this has diverged, as a NaN/Inf step has "
       "(a field that runs away stays finite while it renders the head away). 0: no bound.");
