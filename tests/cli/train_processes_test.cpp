@@ -40,6 +40,11 @@ TEST(CliTrain, TwoProcessesTrainOneModelAndAgree) {
   size_t lines = 0;
   for (size_t at = r.output.find("it 16/16"); at != std::string::npos; at = r.output.find("it 16/16", at + 1)) ++lines;
   EXPECT_EQ(lines, 1u) << r.output;
+  // Its rate in steps and in views: two views a step.
+  std::smatch rate;
+  ASSERT_TRUE(std::regex_search(r.output, rate, std::regex(R"(it 16/16 .* ([0-9.]+) it/s \(([0-9.]+) views/s\))")))
+      << r.output;
+  EXPECT_NEAR(std::stod(rate[2]), 2 * std::stod(rate[1]), 0.07) << rate[0];
 
   const auto both = run_tega(train + " --force --processes 2 --gpus 0,1");
   EXPECT_NE(both.exit_code, 0);

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -218,10 +219,14 @@ class Run {
         summary.final_loss = window_loss / window;
         summary.train_psnr = window_psnr / window;
         metrics_.push_back({iteration_, summary.final_loss, summary.train_psnr, model_.gaussians.size(), seconds});
+        // On several processes a step is one view each: the views a second compare with one GPU's it/s.
+        char views[48] = "";
+        if (!parallel_.alone()) std::snprintf(views, sizeof views, " (%.1f views/s)", rate * parallel_.world());
         if (parallel_.leads())
-          logging::info("it %lld/%lld  loss %.5f  psnr %.2f  gaussians %lld  %.2f it/s  ETA %s",
+          logging::info("it %lld/%lld  loss %.5f  psnr %.2f  gaussians %lld  %.2f it/s%s  ETA %s",
                       static_cast<long long>(iteration_), static_cast<long long>(options_.iterations),
                       summary.final_loss, summary.train_psnr, static_cast<long long>(model_.gaussians.size()), rate,
+                      views,
                       Progress::format_duration(static_cast<double>(options_.iterations - iteration_) / rate).c_str());
         window_loss = window_psnr = 0;
         window = 0;
